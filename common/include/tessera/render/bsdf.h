@@ -1,0 +1,36 @@
+// BSDF interface.
+//
+// Frames: every method takes `wo` and `wi` in the local shading frame of `si` (normal on +z),
+// both unit length and pointing away from the surface. The caller converts with si.to_local.
+// eval() INCLUDES the cosine foreshortening |cos theta_i| (Mitsuba convention).
+// pdf() is a density with respect to SOLID ANGLE of wi; for delta components it is not defined
+// (sample() reports them with `delta = true` and eval()/pdf() return 0 for them).
+// Hot path: no method throws or allocates.
+#pragma once
+
+#include "tessera/core/rgb.h"
+#include "tessera/core/vec.h"
+#include "tessera/render/interaction.h"
+
+namespace tessera {
+
+struct BsdfSample {
+  Vec3 wi;           // local frame
+  float pdf = 0.f;   // solid angle; for a delta lobe, the discrete probability of choosing it
+  Rgb weight;        // eval * |cos| / pdf (for delta lobes: the lobe's throughput / probability)
+  bool delta = false;
+};
+
+class Bsdf {
+ public:
+  virtual ~Bsdf() = default;
+  virtual Rgb eval(const SurfaceInteraction& si, Vec3 wo, Vec3 wi) const = 0;
+  virtual float pdf(const SurfaceInteraction& si, Vec3 wo, Vec3 wi) const = 0;
+  /// `u1` picks a lobe, `u2` the direction within it. False when no direction could be sampled.
+  virtual bool sample(const SurfaceInteraction& si, Vec3 wo, float u1, Vec2 u2,
+                      BsdfSample& out) const = 0;
+  /// True when every lobe is a delta (no next-event estimation possible).
+  virtual bool is_delta() const { return false; }
+};
+
+}  // namespace tessera

@@ -1,0 +1,56 @@
+// Camera, film and pixel-filter interfaces.
+//
+// Raster space: continuous pixel coordinates of the full film, (0,0) at the top-left corner of the
+// top-left pixel, x to the right, y down; pixel (i,j) covers [i,i+1) x [j,j+1).
+// Pixel filters are applied by filter importance sampling (the film position of a sample is drawn
+// from the filter around the pixel centre), so each pixel's value depends on its own samples only.
+#pragma once
+
+#include "tessera/core/ray.h"
+#include "tessera/core/transform.h"
+#include "tessera/core/vec.h"
+
+#include <memory>
+#include <string>
+
+namespace tessera {
+
+class Filter {
+ public:
+  virtual ~Filter() = default;
+  /// Offset from the pixel centre, in pixels, distributed proportionally to the filter.
+  virtual Vec2 sample(Vec2 u) const = 0;
+  virtual float radius() const = 0;
+  virtual std::string name() const = 0;
+};
+
+std::unique_ptr<Filter> make_box_filter(float radius = 0.5f);
+std::unique_ptr<Filter> make_tent_filter(float radius = 1.f);
+std::unique_ptr<Filter> make_gaussian_filter(float stddev = 0.5f, float radius = 2.f);
+
+struct FilmSettings {
+  int width = 768, height = 576;
+  int crop_x = 0, crop_y = 0, crop_width = 0, crop_height = 0;  // crop_width==0: whole film
+  bool ldr = false;            // ldrfilm: PNG gets gamma/exposure below
+  float gamma = -1.f;          // ldrfilm gamma; -1 = sRGB curve
+  float exposure = 0.f;        // ldrfilm exposure in stops
+  std::shared_ptr<const Filter> filter;  // never null after load (Mitsuba default: gaussian)
+  int crop_w() const { return crop_width > 0 ? crop_width : width; }
+  int crop_h() const { return crop_height > 0 ? crop_height : height; }
+};
+
+class Camera {
+ public:
+  virtual ~Camera() = default;
+  /// Ray through raster position `raster` (see above); `u_lens` for depth of field. Direction unit.
+  virtual Ray generate_ray(Vec2 raster, Vec2 u_lens) const = 0;
+};
+
+/// Mitsuba's perspective sensor: looks down +z of `world_from_camera` with +y up, image x mirrored
+/// as Mitsuba does (camera-space +x appears on the left of the image).
+/// `fov_x_degrees` is the horizontal field of view after fovAxis resolution.
+std::unique_ptr<Camera> make_perspective_camera(const Transform& world_from_camera, float fov_x_degrees,
+                                                int film_width, int film_height, float near_clip,
+                                                float far_clip);
+
+}  // namespace tessera

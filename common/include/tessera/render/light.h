@@ -1,0 +1,52 @@
+// Light (emitter) interface.
+//
+// sample_li() samples a direction from a reference point towards the light. Its `pdf` is with
+// respect to SOLID ANGLE at the reference point; for delta lights (point) `pdf` is 1 and `delta`
+// is set. `li` is the radiance arriving (not divided by the pdf).
+// Area lights and environment lights can also be hit by BSDF-sampled rays: le()/le_env() give the
+// emitted radiance, and pdf_li()/pdf_env() the solid-angle density sample_li() would have had, for
+// multiple importance sampling.
+// Hot path: no method throws or allocates.
+#pragma once
+
+#include "tessera/core/bounds.h"
+#include "tessera/core/rgb.h"
+#include "tessera/core/vec.h"
+#include "tessera/render/interaction.h"
+
+namespace tessera {
+
+struct LightSample {
+  Rgb li;               // incident radiance along -wi arriving at the reference point
+  Vec3 wi;              // unit, world space, from the reference point towards the light
+  Vec3 p_light;         // point on the light (for infinite lights: far along wi)
+  Vec3 n_light;         // surface normal at p_light (zero for point/infinite lights)
+  float dist = kInfinity;  // distance to p_light; kInfinity for infinite lights
+  float pdf = 0.f;
+  bool delta = false;
+};
+
+class Light {
+ public:
+  virtual ~Light() = default;
+  /// Called once after the scene geometry is known (infinite lights need its bounds).
+  virtual void preprocess(const Bounds3& scene_bounds) {}
+  virtual bool sample_li(Vec3 ref_p, Vec2 u, LightSample& out) const = 0;
+
+  /// Area lights: radiance leaving the hit point `si` in direction `w` (world).
+  virtual Rgb le(const SurfaceInteraction& si, Vec3 w) const { return {}; }
+  /// Area lights: solid-angle pdf at `ref_p` of sampling the point `si` on this light.
+  virtual float pdf_li(Vec3 ref_p, const SurfaceInteraction& si) const { return 0.f; }
+
+  /// Infinite lights: radiance arriving along a ray that escapes the scene in direction `d`.
+  virtual Rgb le_env(Vec3 d) const { return {}; }
+  /// Infinite lights: solid-angle pdf of sample_li() choosing direction `d`.
+  virtual float pdf_env(Vec3 d) const { return 0.f; }
+
+  virtual bool is_infinite() const { return false; }
+  virtual bool is_delta() const { return false; }
+  /// Total emitted power (an estimate is fine); lights are picked in proportion to it.
+  virtual float power() const = 0;
+};
+
+}  // namespace tessera

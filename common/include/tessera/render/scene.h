@@ -1,0 +1,76 @@
+// A loaded scene: world-space shapes, materials, lights, camera and settings, plus the accelerator.
+// Immutable after load(); shared read-only by all render threads.
+#pragma once
+
+#include "tessera/accel/bvh.h"
+#include "tessera/core/sampling.h"
+#include "tessera/render/bsdf.h"
+#include "tessera/render/camera.h"
+#include "tessera/render/light.h"
+#include "tessera/render/shape.h"
+#include "tessera/render/texture.h"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace tessera {
+
+enum class IntegratorType { Path, Direct };
+
+struct IntegratorSettings {
+  IntegratorType type = IntegratorType::Path;
+  int max_depth = -1;       // -1: unbounded; Mitsuba counts a directly visible emitter as depth 1
+  int rr_depth = 5;         // Russian roulette starts at this depth
+  bool hide_emitters = false;
+  bool strict_normals = false;
+  // direct integrator only
+  int emitter_samples = 1;
+  int bsdf_samples = 1;
+};
+
+enum class SamplerType { Sobol, Independent };
+
+struct SamplerSettings {
+  SamplerType type = SamplerType::Sobol;
+  int sample_count = 4;
+};
+
+class Scene {
+ public:
+  // Everything is owned here; objects refer to each other by raw pointer.
+  std::vector<std::unique_ptr<Shape>> shapes;
+  std::vector<std::shared_ptr<Bsdf>> bsdfs;
+  std::vector<std::shared_ptr<Texture>> textures;
+  std::vector<std::unique_ptr<Light>> lights;
+  std::unique_ptr<Camera> camera;
+  FilmSettings film;
+  SamplerSettings sampler;
+  IntegratorSettings integrator;
+
+  /// Builds the BVH, the primitive->shape map and the light-selection distribution; calls each
+  /// light's preprocess(). Call once after every object was added.
+  void finalize();
+
+  bool intersect(const Ray& ray, SurfaceInteraction& si) const;
+  bool occluded(const Ray& ray) const { return accel_.occluded(ray); }
+
+  /// Picks a light in proportion to power. Null when the scene has none.
+  const Light* sample_light(float u, float& pmf) const;
+  float light_pmf(const Light* light) const;
+  const std::vector<const Light*>& infinite_lights() const { return infinite_lights_; }
+
+  const Bvh& accel() const { return accel_; }
+  Bounds3 bounds() const { return accel_.bounds(); }
+  size_t num_triangles() const { return num_triangles_; }
+
+ private:
+  Bvh accel_;
+  std::vector<uint32_t> prim_shape_;   // global primitive -> shape index
+  std::vector<uint32_t> shape_first_;  // shape index -> first global primitive
+  Distribution1D light_distr_;
+  std::vector<const Light*> infinite_lights_;
+  size_t num_triangles_ = 0;
+};
+
+}  // namespace tessera

@@ -1,0 +1,103 @@
+// Shapes: world-space geometry the accelerator intersects, with what the integrator needs at a hit.
+//
+// Two kinds reach the accelerator: triangle meshes (all of obj/ply/serialized/rectangle/cube/disk
+// end up as these) and analytic spheres. Both are stored in WORLD space: transforms are applied once
+// at load time, so the hot path never transforms rays.
+// Orientation: the geometric normal of a triangle (v0,v1,v2) is normalize(cross(v1-v0, v2-v0)),
+// negated when `flip_normals` is set; a sphere's faces outward (inward when flipped).
+// Area sampling returns a density with respect to AREA on the shape.
+#pragma once
+
+#include "tessera/core/bounds.h"
+#include "tessera/core/ray.h"
+#include "tessera/core/sampling.h"
+#include "tessera/core/vec.h"
+#include "tessera/render/interaction.h"
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace tessera {
+
+class Bsdf;
+class Light;
+
+/// Triangle mesh data as loaders produce it (object space) and as shapes keep it (world space).
+struct MeshData {
+  std::vector<Vec3> positions;
+  std::vector<Vec3> normals;   // per vertex; empty when the mesh has none (or face normals wanted)
+  std::vector<Vec2> uvs;       // per vertex; empty when none
+  std::vector<uint32_t> indices;  // three per triangle
+  size_t num_triangles() const { return indices.size() / 3; }
+};
+
+/// A closest-hit record from the accelerator. For triangles (b1, b2) are the barycentric
+/// coordinates of v1 and v2; spheres leave them unused.
+struct Hit {
+  float t = kInfinity;
+  uint32_t prim = 0xFFFFFFFFu;  // global primitive index (see Scene)
+  float b1 = 0.f, b2 = 0.f;
+};
+
+class Shape {
+ public:
+  enum class Kind { Mesh, Sphere };
+  virtual ~Shape() = default;
+  virtual Kind kind() const = 0;
+  virtual uint32_t num_primitives() const = 0;
+  virtual Bounds3 bounds() const = 0;
+  virtual float area() const = 0;
+  /// Uniformly (by area) samples a point; returns its position, geometric normal and area pdf.
+  virtual void sample_area(Vec2 u, Vec3& p, Vec3& n, float& pdf_area) const = 0;
+  /// Completes `si` for a hit on local primitive `prim` found by the accelerator.
+  virtual void fill_interaction(const Ray& ray, const Hit& hit, uint32_t prim,
+                                SurfaceInteraction& si) const = 0;
+
+  const Bsdf* bsdf = nullptr;
+  const Light* light = nullptr;  // area light attached to this shape, if any
+  std::string name;              // for messages: "shape 'obj' (models/Mesh001.obj)"
+};
+
+class TriangleMeshShape final : public Shape {
+ public:
+  /// `mesh` is in world space already. `face_normals` ignores vertex normals.
+  TriangleMeshShape(std::shared_ptr<const MeshData> mesh, bool flip_normals, bool face_normals);
+  Kind kind() const override { return Kind::Mesh; }
+  uint32_t num_primitives() const override { return uint32_t(mesh_->num_triangles()); }
+  Bounds3 bounds() const override;
+  float area() const override { return area_; }
+  void sample_area(Vec2 u, Vec3& p, Vec3& n, float& pdf_area) const override;
+  void fill_interaction(const Ray& ray, const Hit& hit, uint32_t prim,
+                        SurfaceInteraction& si) const override;
+  const MeshData& mesh() const { return *mesh_; }
+  bool flip_normals() const { return flip_; }
+
+ private:
+  std::shared_ptr<const MeshData> mesh_;
+  bool flip_, face_normals_;
+  float area_ = 0.f;
+  Distribution1D tri_area_;
+};
+
+class SphereShape final : public Shape {
+ public:
+  SphereShape(Vec3 center, float radius, bool flip_normals);
+  Kind kind() const override { return Kind::Sphere; }
+  uint32_t num_primitives() const override { return 1; }
+  Bounds3 bounds() const override;
+  float area() const override { return 4.f * kPi * radius_ * radius_; }
+  void sample_area(Vec2 u, Vec3& p, Vec3& n, float& pdf_area) const override;
+  void fill_interaction(const Ray& ray, const Hit& hit, uint32_t prim,
+                        SurfaceInteraction& si) const override;
+  Vec3 center() const { return center_; }
+  float radius() const { return radius_; }
+
+ private:
+  Vec3 center_;
+  float radius_;
+  bool flip_;
+};
+
+}  // namespace tessera

@@ -1,0 +1,28 @@
+// Texture interface: a spatially varying colour or scalar looked up at a surface point.
+#pragma once
+
+#include "tessera/core/rgb.h"
+#include "tessera/render/interaction.h"
+
+namespace tessera {
+
+class Texture {
+ public:
+  virtual ~Texture() = default;
+  virtual Rgb eval(const SurfaceInteraction& si) const = 0;
+  virtual float eval_1(const SurfaceInteraction& si) const { return eval(si).average(); }
+  /// Mean value over the texture; used to estimate light power and for fallbacks.
+  virtual Rgb mean() const = 0;
+};
+
+class ConstantTexture final : public Texture {
+ public:
+  explicit ConstantTexture(Rgb value) : value_(value) {}
+  Rgb eval(const SurfaceInteraction&) const override { return value_; }
+  Rgb mean() const override { return value_; }
+
+ private:
+  Rgb value_;
+};
+
+}  // namespace tessera

@@ -1,0 +1,114 @@
+// What a plugin factory gets while a scene is being loaded: the node to read parameters from, and
+// this context for shared resources (textures, mesh cache, paths) and for reporting.
+//
+// Each plugin file exports `make_<type>(const SceneNode&, LoadContext&)`; the explicit tables in
+// factories.cpp map Mitsuba type names to them. A factory reads its parameters through the node's
+// typed getters (which mark them used); whatever a factory did not read is reported afterwards as
+// unsupported, unless it is on the list of parameters that do not change the image.
+#pragma once
+
+#include "tessera/core/rgb.h"
+#include "tessera/render/scene.h"
+#include "tessera/render/shape.h"
+#include "tessera/render/texture.h"
+#include "tessera/scene/error.h"
+#include "tessera/scene/scene_desc.h"
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace tessera {
+
+struct LoadOptions {
+  bool allow_unsupported = false;
+  int width = 0, height = 0;     // >0 overrides the film size
+  int spp = 0;                   // >0 overrides the sampler's sample count
+  std::string integrator;        // non-empty overrides the scene's integrator type
+};
+
+struct LoadMessage {
+  enum class Level { Note, Warning } level;
+  FileLoc loc;
+  std::string text;
+};
+
+class LoadContext {
+ public:
+  LoadContext(const SceneDesc& desc, const LoadOptions& options, Scene& scene);
+
+  const SceneDesc& desc() const { return desc_; }
+  const LoadOptions& options() const { return options_; }
+  Scene& scene() { return scene_; }
+
+  /// Resolves a file name relative to the scene's directory; throws SceneError at `loc` if the
+  /// file does not exist or cannot be read.
+  std::string resolve_path(const std::string& name, const FileLoc& loc) const;
+
+  /// A colour parameter that may be a constant (<rgb>, <spectrum>, <float>) or a nested/referenced
+  /// texture. Missing -> constant `def`. Textures are created once per node and shared.
+  std::shared_ptr<Texture> texture(const SceneNode& node, const std::string& name, Rgb def);
+
+  /// Loads a mesh file once per (path, extra key) and shares the result (object space).
+  std::shared_ptr<const MeshData> cached_mesh(const std::string& key,
+                                              const std::function<MeshData()>& load);
+
+  /// Builds (once per node) the BSDF a shape refers to; null node -> the default diffuse BSDF.
+  const Bsdf* bsdf(const std::shared_ptr<SceneNode>& node);
+
+  void note(const FileLoc& loc, const std::string& text);
+  void warn(const FileLoc& loc, const std::string& text);
+  /// Records an unsupported plugin/parameter. Loading fails at the end (all items at once) unless
+  /// options().allow_unsupported, in which case `fallback` is used and one warning is printed.
+  void unsupported(const FileLoc& loc, const std::string& what, const std::string& fallback);
+
+  const std::vector<LoadMessage>& messages() const { return messages_; }
+  const std::vector<UnsupportedItem>& unsupported_items() const { return unsupported_; }
+
+ private:
+  const SceneDesc& desc_;
+  LoadOptions options_;
+  Scene& scene_;
+  std::vector<LoadMessage> messages_;
+  std::vector<UnsupportedItem> unsupported_;
+  std::map<const SceneNode*, std::shared_ptr<Texture>> textures_;
+  std::map<const SceneNode*, const Bsdf*> bsdfs_;
+  std::map<std::string, std::shared_ptr<const MeshData>> meshes_;
+};
+
+using BsdfFactory = std::shared_ptr<Bsdf> (*)(const SceneNode&, LoadContext&);
+using TextureFactory = std::shared_ptr<Texture> (*)(const SceneNode&, LoadContext&);
+/// A light factory for lights that stand alone (point, constant, envmap). Area lights are made by
+/// the shape loader, which knows the shape.
+using LightFactory = std::unique_ptr<Light> (*)(const SceneNode&, LoadContext&);
+/// Shape factories return object-space meshes or a sphere description; the builder applies
+/// `to_world`, attaches BSDF and area light.
+struct ShapeGeometry {
+  std::shared_ptr<const MeshData> mesh;  // for mesh shapes (object space)
+  bool is_sphere = false;
+  Vec3 center;                           // sphere, object space
+  float radius = 1.f;
+  bool face_normals = false;
+  bool flip_normals = false;
+};
+using ShapeFactory = ShapeGeometry (*)(const SceneNode&, LoadContext&);
+
+/// Factory tables (factories.cpp); nullptr when the type is not supported.
+BsdfFactory find_bsdf_factory(const std::string& type);
+TextureFactory find_texture_factory(const std::string& type);
+LightFactory find_light_factory(const std::string& type);
+ShapeFactory find_shape_factory(const std::string& type);
+
+struct LoadResult {
+  std::unique_ptr<Scene> scene;
+  std::vector<LoadMessage> messages;
+  std::vector<UnsupportedItem> unsupported;  // non-empty only with allow_unsupported
+};
+
+/// Parsed description -> renderable scene (meshes and images loaded, BVH built). Throws SceneError,
+/// or UnsupportedError listing every unsupported item when !allow_unsupported.
+LoadResult load_scene(const SceneDesc& desc, const LoadOptions& options);
+
+}  // namespace tessera
