@@ -3,6 +3,7 @@
 #include "tessera/core/check.h"
 
 #include <algorithm>
+#include <chrono>
 
 namespace tessera {
 
@@ -40,7 +41,9 @@ void Scene::finalize() {
     }
   }
   num_triangles_ = tri_count;
+  auto t0 = std::chrono::steady_clock::now();
   accel_ = Bvh::build(std::move(triangles), std::move(spheres));
+  bvh_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   Bounds3 b = accel_.bounds();
   if (b.empty()) b.extend(Vec3(0.f));

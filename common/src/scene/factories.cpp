@@ -8,9 +8,21 @@ namespace tessera {
 
 // Factories, one per plugin file (declared here rather than in headers: nothing else calls them).
 // -- bsdfs --
+std::shared_ptr<Bsdf> make_diffuse(const SceneNode&, LoadContext&);
+std::shared_ptr<Bsdf> make_twosided(const SceneNode&, LoadContext&);
 // -- textures --
 // -- lights --
+std::unique_ptr<Light> make_point(const SceneNode&, LoadContext&);
+std::unique_ptr<Light> make_envmap(const SceneNode&, LoadContext&);
+std::unique_ptr<Light> make_constant(const SceneNode&, LoadContext&);
 // -- shapes --
+ShapeGeometry make_obj(const SceneNode&, LoadContext&);
+ShapeGeometry make_ply(const SceneNode&, LoadContext&);
+ShapeGeometry make_serialized(const SceneNode&, LoadContext&);
+ShapeGeometry make_rectangle(const SceneNode&, LoadContext&);
+ShapeGeometry make_cube(const SceneNode&, LoadContext&);
+ShapeGeometry make_disk(const SceneNode&, LoadContext&);
+ShapeGeometry make_sphere(const SceneNode&, LoadContext&);
 
 namespace {
 
@@ -28,15 +40,27 @@ F find(const Entry<F> (&table)[N], const std::string& type) {
 }
 
 const Entry<BsdfFactory> kBsdfs[] = {
+    {"diffuse", make_diffuse},
+    {"twosided", make_twosided},
     {"", nullptr},
 };
 const Entry<TextureFactory> kTextures[] = {
     {"", nullptr},
 };
 const Entry<LightFactory> kLights[] = {
+    {"point", make_point},
+    {"envmap", make_envmap},
+    {"constant", make_constant},
     {"", nullptr},
 };
 const Entry<ShapeFactory> kShapes[] = {
+    {"obj", make_obj},
+    {"ply", make_ply},
+    {"serialized", make_serialized},
+    {"rectangle", make_rectangle},
+    {"cube", make_cube},
+    {"disk", make_disk},
+    {"sphere", make_sphere},
     {"", nullptr},
 };
 

@@ -63,6 +63,7 @@ class Scene {
   const Bvh& accel() const { return accel_; }
   Bounds3 bounds() const { return accel_.bounds(); }
   size_t num_triangles() const { return num_triangles_; }
+  double bvh_build_seconds() const { return bvh_seconds_; }
 
  private:
   Bvh accel_;
@@ -71,6 +72,7 @@ class Scene {
   Distribution1D light_distr_;
   std::vector<const Light*> infinite_lights_;
   size_t num_triangles_ = 0;
+  double bvh_seconds_ = 0;
 };
 
 }  // namespace tessera

@@ -95,6 +95,10 @@ struct ShapeGeometry {
 };
 using ShapeFactory = ShapeGeometry (*)(const SceneNode&, LoadContext&);
 
+/// The `area` emitter nested in a shape (light/area.cpp); `shape` is the world-space shape it
+/// emits from. The caller attaches the result (shape.light) and moves it into scene.lights.
+std::unique_ptr<Light> make_area_light(const SceneNode& emitter, LoadContext& ctx, const Shape& shape);
+
 /// Factory tables (factories.cpp); nullptr when the type is not supported.
 BsdfFactory find_bsdf_factory(const std::string& type);
 TextureFactory find_texture_factory(const std::string& type);

@@ -1,0 +1,35 @@
+// The `tessera` command's subcommands as library functions (main.cpp only dispatches), so tests
+// can run them in-process.
+#pragma once
+
+#include "tessera/tools/bench_rays.h"
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace tessera::cli {
+
+struct RenderOptions {
+  std::string scene;
+  std::vector<std::string> outputs;        // by extension: .exr .pfm .png
+  int spp = 0, width = 0, height = 0;      // 0: as the scene says
+  int threads = 0;                         // 0: all cores
+  int tile_size = 32;
+  uint32_t seed = 0;
+  std::map<std::string, std::string> defines;
+  std::string integrator;                  // empty: as the scene says
+  bool allow_unsupported = false;
+  bool quiet = false;
+};
+
+/// Each returns the process exit code and prints its own messages.
+int run_render(const RenderOptions& options);
+/// `geometry` may also be a single scene .xml: its accelerator is used.
+int run_bench_rays(const BenchRaysOptions& options);
+
+/// Parses argv and runs the chosen subcommand.
+int main_entry(int argc, char** argv);
+
+}  // namespace tessera::cli

@@ -1,0 +1,70 @@
+// Command-line surface of `tessera` (CLI11). Only option parsing; each subcommand is a library call.
+#include "tessera/cli/commands.h"
+
+#include <CLI/CLI.hpp>
+
+#include <iostream>
+
+namespace tessera::cli {
+namespace {
+
+// "-D name=value" -> defines[name] = value.
+bool parse_define(const std::string& kv, std::map<std::string, std::string>& out) {
+  auto eq = kv.find('=');
+  if (eq == std::string::npos || eq == 0) return false;
+  out[kv.substr(0, eq)] = kv.substr(eq + 1);
+  return true;
+}
+
+}  // namespace
+
+int main_entry(int argc, char** argv) {
+  CLI::App app{"Tessera: a physically based path tracer for Mitsuba scenes"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("tessera ") + TESSERA_VERSION);
+
+  RenderOptions render;
+  std::vector<std::string> defines;
+  auto* r = app.add_subcommand("render", "Render a Mitsuba XML scene to EXR/PFM/PNG");
+  r->add_option("scene", render.scene, "Scene file (Mitsuba XML 0.5/0.6 or 2.x/3.x)")->required();
+  r->add_option("-o,--output", render.outputs, "Output image(s): .exr, .pfm or .png")->required();
+  r->add_option("--spp", render.spp, "Samples per pixel (default: the scene's)")->check(CLI::PositiveNumber);
+  r->add_option("--width", render.width, "Film width (default: the scene's)")->check(CLI::PositiveNumber);
+  r->add_option("--height", render.height, "Film height (default: the scene's)")->check(CLI::PositiveNumber);
+  r->add_option("--threads", render.threads, "Render threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  r->add_option("--tile-size", render.tile_size, "Tile edge in pixels (does not change the image)")
+      ->check(CLI::Range(1, 4096));
+  r->add_option("--seed", render.seed, "Sampling seed");
+  r->add_option("-D", defines, "Override a scene <default>: -D name=value");
+  r->add_option("--integrator", render.integrator, "Override the integrator")
+      ->check(CLI::IsMember({"path", "direct"}));
+  r->add_flag("--allow-unsupported", render.allow_unsupported,
+              "Substitute documented fallbacks for unsupported plugins/parameters");
+  r->add_flag("-q,--quiet", render.quiet, "No progress output");
+
+  auto* bench = app.add_subcommand("bench", "Benchmarks");
+  bench->require_subcommand(1);
+  tessera::BenchRaysOptions rays;
+  auto* br = bench->add_subcommand("rays", "Trace a ray file (../shared/docs/rayfile.md) and report Mrays/s");
+  br->add_option("geometry", rays.geometry, "Scene .xml, or OBJ files/folders")->required();
+  br->add_option("--rays", rays.rays, "Ray file")->required()->check(CLI::ExistingFile);
+  br->add_option("--hits", rays.hits_out, "Write the hit file here");
+  br->add_option("--compare", rays.compare, "Reference hit file to check agreement against")
+      ->check(CLI::ExistingFile);
+  br->add_option("--threads", rays.threads, "Threads (default: all cores)")->check(CLI::NonNegativeNumber);
+
+  CLI11_PARSE(app, argc, argv);
+
+  if (r->parsed()) {
+    for (const auto& d : defines)
+      if (!parse_define(d, render.defines)) {
+        std::cerr << "tessera render: -D expects name=value, got '" << d << "'\n";
+        return 2;
+      }
+    return run_render(render);
+  }
+  if (br->parsed()) return run_bench_rays(rays);
+  return 2;
+}
+
+}  // namespace tessera::cli

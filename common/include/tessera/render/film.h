@@ -1,0 +1,132 @@
+// Sample accumulation.
+//
+// Every pixel keeps double-precision sums of its samples' RGB and of their squares (for variance
+// estimates) and a sample count. A FilmTile holds the sums of ONE pass over one rectangle; the
+// Film adds finished tile passes. Each pixel's value is therefore
+//   ((s_0 + s_1 + ...) in index order within a pass) + ... in pass order,
+// which makes the result independent of thread count, tile size and the machine a tile ran on.
+// Non-finite samples never reach the sums: they count as a sample of value 0 and are tallied.
+#pragma once
+
+#include "tessera/core/rgb.h"
+#include "tessera/core/vec.h"
+#include "tessera/image/image.h"
+#include "tessera/render/camera.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace tessera {
+
+/// Half-open pixel rectangle [x0, x1) x [y0, y1) in full-film raster pixels.
+struct TileRect {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+  int width() const { return x1 - x0; }
+  int height() const { return y1 - y0; }
+  int64_t area() const { return int64_t(width()) * height(); }
+  bool empty() const { return x1 <= x0 || y1 <= y0; }
+  bool contains(Vec2i p) const { return p.x >= x0 && p.x < x1 && p.y >= y0 && p.y < y1; }
+  bool contains(const TileRect& r) const {
+    return r.x0 >= x0 && r.y0 >= y0 && r.x1 <= x1 && r.y1 <= y1;
+  }
+  bool operator==(const TileRect&) const = default;
+};
+
+/// The film's crop window (the pixels that are rendered).
+TileRect film_window(const FilmSettings& film);
+
+struct PixelSums {
+  double sum[3] = {0, 0, 0};
+  double sum_sq[3] = {0, 0, 0};
+  uint64_t count = 0;
+};
+
+/// Work done while rendering; a tile carries its own so that totals are exact whatever the
+/// threading, and a remote tile can report them.
+struct RenderCounters {
+  uint64_t samples = 0;
+  uint64_t camera_rays = 0;
+  uint64_t bounce_rays = 0;   // continuation rays, including the direct integrator's BSDF rays
+  uint64_t shadow_rays = 0;
+  uint64_t nonfinite = 0;     // NaN/Inf samples dropped
+  uint64_t rays() const { return camera_rays + bounce_rays + shadow_rays; }
+  RenderCounters& operator+=(const RenderCounters& o);
+};
+
+class FilmTile {
+ public:
+  FilmTile() = default;
+  explicit FilmTile(const TileRect& rect);
+  /// Zeroes the sums and counters and moves the tile to `rect` (reuses storage).
+  void reset(const TileRect& rect);
+
+  const TileRect& rect() const { return rect_; }
+  /// Adds one sample of `pixel` (inside rect()). A non-finite value adds 0 and is counted.
+  void add_sample(Vec2i pixel, Rgb value) {
+    PixelSums& px = pixels_[index(pixel)];
+    ++px.count;
+    ++counters.samples;
+    if (!value.is_finite()) {
+      ++counters.nonfinite;
+      return;
+    }
+    for (int c = 0; c < 3; ++c) {
+      double v = value[c];
+      px.sum[c] += v;
+      px.sum_sq[c] += v * v;
+    }
+  }
+  const PixelSums& pixel(Vec2i p) const { return pixels_[index(p)]; }
+  const std::vector<PixelSums>& pixels() const { return pixels_; }
+
+  RenderCounters counters;
+
+ private:
+  size_t index(Vec2i p) const { return size_t(p.y - rect_.y0) * size_t(rect_.width()) + size_t(p.x - rect_.x0); }
+  TileRect rect_;
+  std::vector<PixelSums> pixels_;
+};
+
+class Film {
+ public:
+  Film() = default;
+  /// A film for the pixels of `window` (full-film coordinates); `full_width/height` are the
+  /// film's complete size, kept for writers that need the crop offset.
+  Film(const TileRect& window, int full_width, int full_height);
+  explicit Film(const FilmSettings& settings);
+
+  const TileRect& window() const { return window_; }
+  int width() const { return window_.width(); }
+  int height() const { return window_.height(); }
+  int full_width() const { return full_width_; }
+  int full_height() const { return full_height_; }
+
+  /// Adds the pixel sums of a finished tile pass (must lie inside window()). Concurrent calls for
+  /// disjoint tiles are safe; the tile's counters are NOT added (see add_counters).
+  void add_tile(const FilmTile& tile);
+  void add_counters(const RenderCounters& c) { counters_ += c; }
+
+  /// Pixel by full-film coordinates.
+  const PixelSums& pixel(Vec2i p) const { return pixels_[index(p)]; }
+  Rgb mean(Vec2i p) const;
+  /// Unbiased sample variance of the pixel's samples, per channel (0 with fewer than 2 samples).
+  Rgb sample_variance(Vec2i p) const;
+
+  /// Mean radiance, row-major over window(), 3 floats per pixel.
+  std::vector<float> to_rgb() const;
+  /// Mean radiance as a 3-channel linear image of the window.
+  Image to_image() const;
+  /// Per-pixel variance of the mean (sample variance / count), 3 channels: a noise estimate.
+  Image variance_image() const;
+
+  const RenderCounters& counters() const { return counters_; }
+
+ private:
+  size_t index(Vec2i p) const { return size_t(p.y - window_.y0) * size_t(window_.width()) + size_t(p.x - window_.x0); }
+  TileRect window_;
+  int full_width_ = 0, full_height_ = 0;
+  std::vector<PixelSums> pixels_;
+  RenderCounters counters_;
+};
+
+}  // namespace tessera

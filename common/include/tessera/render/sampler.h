@@ -1,0 +1,65 @@
+// Stateless-by-construction sample generator.
+//
+// A sample value depends only on (pixel, sample index, dimension, seed): the sampler keeps nothing
+// but a dimension counter, so an image is bit-identical for any thread count, tile size or tile
+// order, and a tile rendered on another machine reproduces the same bits.
+//
+// Dimension allocation (the counter advances by 1 per next_1d() and by 2 per next_2d()):
+//   camera:      film position 2D (dims 0-1), lens 2D (dims 2-3)
+//   per bounce:  light pick 1D, light position 2D, BSDF lobe 1D, BSDF direction 2D, Russian
+//                roulette 1D  (7 dimensions per bounce, always consumed in this order so that a
+//                given dimension means the same thing in every path)
+// The direct integrator uses, per hit, (1D + 2D) per emitter sample then (1D + 2D) per BSDF sample.
+//
+// Types:
+//   Sobol        Owen-scrambled, shuffled Sobol with padding (Burley 2020, "Practical Hash-based
+//                Owen Scrambling"): each 1D/2D request is its own padded (0,2)-sequence whose index
+//                is shuffled by a nested uniform scramble seeded with hash(pixel, dim, seed), and
+//                whose coordinates are then Owen-scrambled with further hashes.
+//   Independent  hash(pixel, index, dim, seed) -> uniform.
+#pragma once
+
+#include "tessera/core/vec.h"
+#include "tessera/render/scene.h"
+
+#include <cstdint>
+
+namespace tessera {
+
+class Sampler {
+ public:
+  Sampler(SamplerType type, uint32_t seed) : type_(type), seed_(seed) {}
+
+  /// Positions the sampler at sample `index` of `pixel` (full-film raster pixel), dimension 0.
+  void start_pixel_sample(Vec2i pixel, uint32_t index) {
+    pixel_ = pixel;
+    index_ = index;
+    dim_ = 0;
+  }
+  /// Uniform in [0, 1).
+  float next_1d();
+  /// Uniform in [0, 1)^2.
+  Vec2 next_2d();
+
+  uint32_t dimension() const { return dim_; }
+  SamplerType type() const { return type_; }
+  uint32_t seed() const { return seed_; }
+
+ private:
+  uint64_t dim_hash(uint32_t dim) const;
+
+  SamplerType type_;
+  uint32_t seed_;
+  Vec2i pixel_;
+  uint32_t index_ = 0;
+  uint32_t dim_ = 0;
+};
+
+namespace sobol {
+/// Bits of the first two Sobol dimensions (dim 0: van der Corput; dim 1: the Pascal matrix).
+uint32_t sample(uint32_t index, int dim);
+/// Burley's nested uniform scramble (an Owen scramble of a 32-bit fixed-point value).
+uint32_t nested_uniform_scramble(uint32_t x, uint32_t seed);
+}  // namespace sobol
+
+}  // namespace tessera

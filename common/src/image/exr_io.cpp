@@ -1,0 +1,132 @@
+// OpenEXR through the general FrameBuffer API, so that half and float channels, tiled files and
+// data windows not at the origin are all read the same way.
+#include "tessera/image/image.h"
+
+#include "image/io_util.h"
+
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfIntAttribute.h>
+#include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfStringAttribute.h>
+
+#include <charconv>
+#include <climits>
+#include <exception>
+#include <set>
+
+namespace tessera {
+
+namespace {
+
+using image_detail::fail;
+
+// Header attributes OpenEXR defines or writes itself; user attributes must not shadow them.
+const std::set<std::string>& reserved_attribute_names() {
+  static const std::set<std::string> names = {
+      "channels", "compression", "dataWindow", "displayWindow", "lineOrder", "pixelAspectRatio",
+      "screenWindowCenter", "screenWindowWidth", "tiles", "type", "name", "chunkCount",
+      "maxSamplesPerPixel"};
+  return names;
+}
+
+bool parse_int32(const std::string& s, int& out) {
+  if (s.empty()) return false;
+  // A leading '+' or zero-padding would not survive a round trip, so keep such values as strings.
+  if (s[0] == '+' || (s.size() > 1 && s[0] == '0') || (s.size() > 2 && s[0] == '-' && s[1] == '0'))
+    return false;
+  if (s == "-0") return false;
+  auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
+  return ec == std::errc() && ptr == s.data() + s.size();
+}
+
+}  // namespace
+
+Image read_exr(const std::string& path, ImageAttributes* attributes) {
+  image_detail::require_readable_file(path);
+  try {
+    Imf::InputFile file(path.c_str());
+    const Imf::Header& header = file.header();
+    const Imath::Box2i dw = header.dataWindow();
+    long long w = (long long)dw.max.x - dw.min.x + 1, h = (long long)dw.max.y - dw.min.y + 1;
+    if (w <= 0 || h <= 0 || w > INT_MAX / 4 || h > INT_MAX / 4 || w * h > (1LL << 31))
+      fail(path, "EXR data window is empty or too large");
+
+    const Imf::ChannelList& ch = header.channels();
+    bool has_r = ch.findChannel("R"), has_g = ch.findChannel("G"), has_b = ch.findChannel("B");
+    bool has_a = ch.findChannel("A"), has_y = ch.findChannel("Y");
+    std::vector<std::string> names;
+    if (has_r || has_g || has_b) {
+      if (!(has_r && has_g && has_b)) fail(path, "EXR has only some of the channels R, G, B");
+      names = {"R", "G", "B"};
+      if (has_a) names.push_back("A");
+    } else if (has_y) {
+      names = {"Y"};  // a luminance image: alpha, if any, is dropped
+    } else {
+      std::string found;
+      for (auto it = ch.begin(); it != ch.end(); ++it) found += std::string(found.empty() ? "" : ", ") + it.name();
+      fail(path, "EXR has no R,G,B or Y channels (found: " + (found.empty() ? "none" : found) + ")");
+    }
+    for (const auto& n : names) {
+      const Imf::Channel* c = ch.findChannel(n);
+      if (c->xSampling != 1 || c->ySampling != 1) fail(path, "EXR channel " + n + " is subsampled (unsupported)");
+    }
+
+    Image img(int(w), int(h), int(names.size()));
+    Imf::FrameBuffer fb;
+    size_t xstride = sizeof(float) * names.size(), ystride = xstride * size_t(w);
+    for (size_t c = 0; c < names.size(); ++c)
+      fb.insert(names[c], Imf::Slice::Make(Imf::FLOAT, img.data() + c, dw, xstride, ystride));
+    file.setFrameBuffer(fb);
+    file.readPixels(dw.min.y, dw.max.y);
+
+    if (attributes) {
+      attributes->clear();
+      for (auto it = header.begin(); it != header.end(); ++it) {
+        if (auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))
+          (*attributes)[it.name()] = s->value();
+        else if (auto* i = dynamic_cast<const Imf::IntAttribute*>(&it.attribute()))
+          (*attributes)[it.name()] = std::to_string(i->value());
+      }
+    }
+    return img;
+  } catch (const SceneError&) {
+    throw;
+  } catch (const std::exception& e) {
+    fail(path, std::string("cannot read EXR: ") + e.what());
+  }
+}
+
+void write_exr(const std::string& path, const Image& image_in, const ImageAttributes& attributes) {
+  if (image_in.empty()) fail(path, "cannot write an empty image");
+  const Image image = image_in.srgb_encoded() ? image_in.linearized() : image_in;
+  Imf::Header header(image.width(), image.height());
+  header.compression() = Imf::ZIP_COMPRESSION;
+  static const char* kNames[3][4] = {{"Y"}, {"R", "G", "B"}, {"R", "G", "B", "A"}};
+  const char* const* names = image.channels() == 1 ? kNames[0] : (image.channels() == 3 ? kNames[1] : kNames[2]);
+  for (int c = 0; c < image.channels(); ++c) header.channels().insert(names[c], Imf::Channel(Imf::FLOAT));
+  for (const auto& [key, value] : attributes) {
+    if (key.empty() || reserved_attribute_names().count(key))
+      fail(path, "EXR attribute name '" + key + "' is empty or reserved");
+    int iv = 0;
+    if (parse_int32(value, iv)) header.insert(key, Imf::IntAttribute(iv));
+    else header.insert(key, Imf::StringAttribute(value));
+  }
+  try {
+    Imf::OutputFile file(path.c_str(), header);
+    Imf::FrameBuffer fb;
+    size_t xstride = sizeof(float) * size_t(image.channels()), ystride = xstride * size_t(image.width());
+    // OpenEXR's Slice takes a non-const pointer even for output.
+    char* base = reinterpret_cast<char*>(const_cast<float*>(image.data()));
+    for (int c = 0; c < image.channels(); ++c)
+      fb.insert(names[c], Imf::Slice(Imf::FLOAT, base + sizeof(float) * size_t(c), xstride, ystride));
+    file.setFrameBuffer(fb);
+    file.writePixels(image.height());
+  } catch (const std::exception& e) {
+    fail(path, std::string("cannot write EXR: ") + e.what());
+  }
+}
+
+}  // namespace tessera

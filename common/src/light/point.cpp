@@ -1,0 +1,56 @@
+#include "tessera/light/point.h"
+
+#include "tessera/scene/load_context.h"
+
+namespace tessera {
+namespace {
+
+class PointLight final : public Light {
+ public:
+  PointLight(Vec3 position, Rgb intensity) : position_(position), intensity_(intensity) {}
+
+  bool sample_li(Vec3 ref_p, Vec2, LightSample& out) const override {
+    Vec3 d = position_ - ref_p;
+    float dist2 = length_squared(d);
+    if (!(dist2 > 0.f)) return false;
+    float dist = std::sqrt(dist2);
+    out.wi = d / dist;
+    out.li = intensity_ / dist2;
+    out.p_light = position_;
+    out.n_light = Vec3(0.f);
+    out.dist = dist;
+    out.pdf = 1.f;
+    out.delta = true;
+    return true;
+  }
+
+  bool is_delta() const override { return true; }
+  float power() const override { return 4.f * kPi * intensity_.average(); }
+
+ private:
+  Vec3 position_;
+  Rgb intensity_;
+};
+
+}  // namespace
+
+std::unique_ptr<Light> make_point_light(Vec3 position, Rgb intensity) {
+  return std::make_unique<PointLight>(position, intensity);
+}
+
+// Mitsuba 0.6 and 3: `position`, or else the translation of `to_world`; `intensity` defaults to
+// white 1 (D65 reduced to RGB).
+std::unique_ptr<Light> make_point(const SceneNode& node, LoadContext& ctx) {
+  Vec3 position;
+  if (node.has("position")) {
+    if (node.has("to_world"))
+      throw SceneError(node.loc, node.describe() + ": give either 'position' or 'to_world', not both");
+    position = node.get_vector("position", Vec3(0.f));
+  } else {
+    position = node.get_transform("to_world", Transform()).apply_point(Vec3(0.f));
+  }
+  Rgb intensity = node.get_color("intensity", Rgb(1.f));
+  return make_point_light(position, intensity);
+}
+
+}  // namespace tessera

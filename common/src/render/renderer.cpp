@@ -1,0 +1,120 @@
+#include "tessera/render/renderer.h"
+
+#include "tessera/core/check.h"
+#include "tessera/render/integrator.h"
+#include "tessera/render/sampler.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <mutex>
+
+namespace tessera {
+
+std::vector<uint32_t> pass_schedule(uint32_t spp) {
+  std::vector<uint32_t> passes;
+  uint32_t done = 0, next = 1;
+  while (done < spp) {
+    uint32_t n = std::min(next, spp - done);
+    passes.push_back(n);
+    done += n;
+    next = std::min(next * 2, 64u);
+  }
+  return passes;
+}
+
+std::vector<TileRect> make_tiles(const TileRect& window, int tile_size) {
+  TESSERA_CHECK(tile_size > 0);
+  std::vector<TileRect> tiles;
+  for (int y = window.y0; y < window.y1; y += tile_size)
+    for (int x = window.x0; x < window.x1; x += tile_size)
+      tiles.push_back({x, y, std::min(x + tile_size, window.x1), std::min(y + tile_size, window.y1)});
+  return tiles;
+}
+
+namespace {
+
+void render_tile_with(const Scene& scene, const Integrator& integrator, const Filter* filter,
+                      const TileRect& rect, uint32_t sample_begin, uint32_t sample_end, uint32_t seed,
+                      FilmTile& tile) {
+  TESSERA_CHECK(scene.camera != nullptr);
+  tile.reset(rect);
+  Sampler sampler(scene.sampler.type, seed);
+  for (int y = rect.y0; y < rect.y1; ++y) {
+    for (int x = rect.x0; x < rect.x1; ++x) {
+      for (uint32_t s = sample_begin; s < sample_end; ++s) {
+        sampler.start_pixel_sample({x, y}, s);
+        Vec2 u_film = sampler.next_2d();
+        Vec2 u_lens = sampler.next_2d();
+        // Without a filter (scenes built in code): a box over the pixel.
+        Vec2 offset = filter ? filter->sample(u_film) : Vec2(u_film.x - 0.5f, u_film.y - 0.5f);
+        Vec2 raster(float(x) + 0.5f + offset.x, float(y) + 0.5f + offset.y);
+        Ray ray = scene.camera->generate_ray(raster, u_lens);
+        ++tile.counters.camera_rays;
+        Rgb L = integrator.li(scene, ray, sampler, tile.counters);
+        tile.add_sample({x, y}, L);
+      }
+    }
+  }
+}
+
+}  // namespace
+
+void render_tile(const Scene& scene, const TileRect& rect, uint32_t sample_begin, uint32_t sample_end,
+                 uint32_t seed, FilmTile& tile) {
+  auto integrator = make_integrator(scene.integrator);
+  render_tile_with(scene, *integrator, scene.film.filter.get(), rect, sample_begin, sample_end, seed, tile);
+}
+
+Film render(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress,
+            RenderStats* stats) {
+  auto start = std::chrono::steady_clock::now();
+  TESSERA_CHECK(settings.spp >= 0 && settings.tile_size > 0);
+  Film film(scene.film);
+  const std::vector<TileRect> tiles = make_tiles(film.window(), settings.tile_size);
+  const std::vector<uint32_t> passes = pass_schedule(uint32_t(settings.spp));
+  auto integrator = make_integrator(scene.integrator);
+  const Filter* filter = scene.film.filter.get();
+
+  RenderProgress prog;
+  prog.num_passes = int(passes.size());
+  prog.tiles_total = int64_t(tiles.size() * passes.size());
+  prog.spp = uint32_t(settings.spp);
+  std::mutex mutex;  // guards counters and progress; taken once per tile
+  RenderCounters counters;
+
+  tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
+  arena.execute([&] {
+    uint32_t begin = 0;
+    for (size_t p = 0; p < passes.size(); ++p) {
+      const uint32_t end = begin + passes[p];
+      prog.pass = int(p);
+      // Tiles are disjoint, so adding their sums concurrently touches distinct pixels; passes are
+      // separated by the parallel_for barrier, which fixes the per-pixel order of pass sums.
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
+        FilmTile tile;
+        for (size_t i = r.begin(); i != r.end(); ++i) {
+          render_tile_with(scene, *integrator, filter, tiles[i], begin, end, settings.seed, tile);
+          film.add_tile(tile);
+          std::lock_guard<std::mutex> lock(mutex);
+          counters += tile.counters;
+          ++prog.tiles_done;
+          if (progress) progress(prog);
+        }
+      });
+      begin = end;
+      prog.samples_done = end;
+    }
+  });
+  film.add_counters(counters);
+  if (stats) {
+    stats->counters = counters;
+    stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  return film;
+}
+
+}  // namespace tessera

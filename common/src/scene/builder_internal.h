@@ -1,0 +1,34 @@
+// Internal to the scene builder: state shared by its parts (scene_builder.cpp builds shapes and
+// lights, sensor_builder.cpp the integrator/camera/film/sampler, unsupported_report.cpp walks the
+// description afterwards and reports whatever was not consumed).
+#pragma once
+
+#include "tessera/scene/load_context.h"
+
+#include <set>
+
+namespace tessera::detail {
+
+struct BuildState {
+  LoadContext& ctx;
+  const SceneDesc& desc;
+  Scene& scene;
+  /// Nodes a builder already reported (or deliberately dropped): the final walk skips them whole.
+  std::set<const SceneNode*> reported;
+  /// Nodes whose own parameters are not checked (e.g. an unsupported sensor read as a pinhole
+  /// camera), though their children are.
+  std::set<const SceneNode*> params_exempt;
+};
+
+void build_integrator(BuildState& st);
+void build_sensor(BuildState& st);  // after the shapes: a missing sensor is fitted to the scene bounds
+void build_shapes(BuildState& st);
+void build_emitters(BuildState& st);
+void report_unsupported(BuildState& st);
+
+/// What --allow-unsupported substitutes for an unsupported plugin node.
+std::string fallback_for(const SceneNode& node);
+/// The constant an unsupported texture is replaced by (its mean where known, else 0.5 grey).
+Rgb texture_fallback_value(const SceneNode& node);
+
+}  // namespace tessera::detail

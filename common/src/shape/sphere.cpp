@@ -1,0 +1,50 @@
+// Analytic spheres (world space: the builder folds to_world into centre and radius).
+#include "tessera/core/check.h"
+#include "tessera/render/shape.h"
+
+#include <cmath>
+
+namespace tessera {
+
+SphereShape::SphereShape(Vec3 center, float radius, bool flip_normals)
+    : center_(center), radius_(radius), flip_(flip_normals) {
+  TESSERA_CHECK(radius > 0.f && std::isfinite(radius));
+  TESSERA_CHECK(is_finite(center));
+}
+
+Bounds3 SphereShape::bounds() const {
+  Bounds3 b;
+  b.extend(center_ - Vec3(radius_));
+  b.extend(center_ + Vec3(radius_));
+  return b;
+}
+
+void SphereShape::sample_area(Vec2 u, Vec3& p, Vec3& n, float& pdf_area) const {
+  Vec3 d = square_to_uniform_sphere(u);
+  p = center_ + d * radius_;
+  n = flip_ ? -d : d;
+  pdf_area = 1.f / area();
+}
+
+void SphereShape::fill_interaction(const Ray& ray, const Hit& hit, uint32_t prim,
+                                   SurfaceInteraction& si) const {
+  Vec3 d = ray.at(hit.t) - center_;
+  float l2 = length_squared(d);
+  // A hit exactly at the centre cannot happen for a real sphere hit; guard anyway.
+  Vec3 n = l2 > 0.f ? d / std::sqrt(l2) : Vec3(0.f, 0.f, 1.f);
+  // Re-project onto the surface: ray.at(t) carries the error of t (Mitsuba does the same).
+  si.p = center_ + n * radius_;
+  si.t = hit.t;
+  si.ng = flip_ ? -n : n;
+  si.shading = Frame(si.ng);
+  // Mitsuba's spherical map in the sphere's axis-aligned frame: u = phi / 2pi, v = theta / pi.
+  float phi = std::atan2(n.y, n.x);
+  if (phi < 0.f) phi += 2.f * kPi;
+  float theta = std::acos(std::fmin(1.f, std::fmax(-1.f, n.z)));
+  si.uv = Vec2(phi * kInv2Pi, theta * kInvPi);
+  si.wo = normalize(-ray.d);
+  si.shape = this;
+  si.prim = prim;
+}
+
+}  // namespace tessera

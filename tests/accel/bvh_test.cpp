@@ -1,0 +1,188 @@
+// BVH against brute force, layout invariants, and build determinism across thread counts.
+#include "accel_test_support.h"
+#include "tessera/accel/bvh.h"
+
+#include <gtest/gtest.h>
+#include <tbb/task_arena.h>
+
+#include <cstring>
+
+namespace tessera {
+namespace {
+
+using test::Triangle;
+
+/// Rays of several kinds: random origins and directions, origins inside the scene (so inside node
+/// boxes), axis-aligned directions (zero components), and finite [tmin, tmax] segments.
+std::vector<Ray> random_rays(Pcg32& rng, size_t n) {
+  std::vector<Ray> rays(n);
+  for (size_t i = 0; i < n; ++i) {
+    Ray& r = rays[i];
+    r.o = test::random_in_box(rng, i % 2 ? -8.f : -16.f, i % 2 ? 8.f : 16.f);
+    r.d = test::random_unit(rng);
+    switch (i % 5) {
+      case 1: {  // axis-aligned: two exact zeros in the direction
+        const int axis = int(rng.next_u32() % 3);
+        r.d = Vec3(0.f);
+        r.d[axis] = rng.next_float() < 0.5f ? -1.f : 1.f;
+        break;
+      }
+      case 2:  // a segment
+        r.tmin = 2.f * rng.next_float();
+        r.tmax = r.tmin + 10.f * rng.next_float();
+        break;
+      case 3:  // unnormalised direction with one zero component
+        r.d = r.d * 3.f;
+        r.d[int(rng.next_u32() % 3)] = 0.f;
+        break;
+      default:
+        break;
+    }
+  }
+  return rays;
+}
+
+void check_against_brute_force(size_t num_tris, size_t num_spheres, size_t num_rays, uint64_t seed) {
+  Pcg32 rng(seed);
+  std::vector<Triangle> tris = test::random_triangles(rng, num_tris);
+  std::vector<SpherePrim> spheres = test::random_spheres(rng, num_spheres);
+  if (num_tris > 4) {  // degenerate triangles must never hit
+    tris[1] = {tris[1][0], tris[1][0], tris[1][2]};
+    tris[3] = {tris[3][0], tris[3][1], tris[3][0] + (tris[3][1] - tris[3][0]) * 2.f};
+  }
+  const Bvh bvh = Bvh::build(tris, spheres);
+  const std::vector<Ray> rays = random_rays(rng, num_rays);
+  size_t hits = 0;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    const Ray& ray = rays[i];
+    Hit expected, got;
+    const bool e = test::brute_intersect(tris, spheres, ray, expected);
+    const bool g = bvh.intersect(ray, got);
+    ASSERT_EQ(e, g) << "ray " << i;
+    EXPECT_EQ(bvh.occluded(ray), e) << "ray " << i;
+    if (!e) continue;
+    ++hits;
+    ASSERT_EQ(expected.t, got.t) << "ray " << i;  // same kernel, so the same bits
+    if (expected.prim != got.prim) {
+      // A tie: the BVH's primitive must be hit at the same distance.
+      ASSERT_LT(got.prim, tris.size());
+      const Triangle& t = tris[got.prim];
+      float tt, b1, b2;
+      ASSERT_TRUE(intersect_triangle(ray, t[0], t[1], t[2], tt, b1, b2));
+      EXPECT_EQ(tt, got.t);
+    } else {
+      EXPECT_EQ(expected.b1, got.b1);
+      EXPECT_EQ(expected.b2, got.b2);
+    }
+  }
+  if (num_tris + num_spheres >= 100) {
+    EXPECT_GT(hits, num_rays / 10);  // the comparison must exercise hits
+  }
+}
+
+TEST(Bvh, EmptyNeverHits) {
+  const Bvh bvh = Bvh::build({}, {});
+  Hit hit;
+  EXPECT_FALSE(bvh.intersect(Ray{Vec3(0.f), Vec3(0, 0, 1)}, hit));
+  EXPECT_FALSE(bvh.occluded(Ray{Vec3(0.f), Vec3(0, 0, 1)}));
+  EXPECT_TRUE(bvh.bounds().empty());
+}
+
+TEST(Bvh, OnlyDegenerateTrianglesNeverHit) {
+  const Vec3 a(0, 0, 0), b(1, 0, 0);
+  const Bvh bvh = Bvh::build({{a, a, b}, {a, b, Vec3(2, 0, 0)}, {a, b, Vec3(kInfinity, 0, 0)}}, {});
+  EXPECT_TRUE(bvh.nodes().empty());
+  Hit hit;
+  EXPECT_FALSE(bvh.intersect(Ray{Vec3(0.5f, 0, -1), Vec3(0, 0, 1)}, hit));
+}
+
+TEST(Bvh, MatchesBruteForceOneTriangle) { check_against_brute_force(1, 0, 2000, 1); }
+TEST(Bvh, MatchesBruteForceTwoTriangles) { check_against_brute_force(2, 0, 2000, 2); }
+TEST(Bvh, MatchesBruteForceOneSphere) { check_against_brute_force(0, 1, 2000, 3); }
+TEST(Bvh, MatchesBruteForce1000Triangles) { check_against_brute_force(1000, 0, 3000, 4); }
+TEST(Bvh, MatchesBruteForceMixed) { check_against_brute_force(1000, 40, 3000, 5); }
+TEST(Bvh, MatchesBruteForce50kTrianglesAndSpheres) { check_against_brute_force(50000, 20, 300, 6); }
+
+TEST(Bvh, MatchesBruteForceCoincidentCentroids) {
+  // Many copies of one triangle (all centroids equal) force the median fallback.
+  Pcg32 rng(7);
+  std::vector<Triangle> tris(200, Triangle{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)});
+  for (size_t i = 0; i < tris.size(); ++i) tris[i][2].z = 0.001f * float(i % 3);  // a few distinct ones
+  const Bvh bvh = Bvh::build(tris, {});
+  for (const BvhNode& n : bvh.nodes()) EXPECT_LE(n.count, 8);
+  for (int i = 0; i < 500; ++i) {
+    Ray ray{test::random_in_box(rng, -2.f, 2.f), test::random_unit(rng)};
+    Hit e, g;
+    ASSERT_EQ(test::brute_intersect(tris, {}, ray, e), bvh.intersect(ray, g));
+    if (g.prim != 0xFFFFFFFFu) {
+      EXPECT_EQ(e.t, g.t);
+    }
+  }
+}
+
+/// Checks the documented flat layout; returns the number of leaf primitives.
+size_t check_layout(const Bvh& bvh, uint32_t node, int depth, uint32_t& next_prim) {
+  const auto& nodes = bvh.nodes();
+  const BvhNode& n = nodes[node];
+  EXPECT_LT(depth, 60);
+  if (n.count > 0) {
+    EXPECT_LE(n.count, 8);
+    EXPECT_EQ(n.offset, next_prim);  // leaves cover consecutive ranges in depth-first order
+    next_prim += n.count;
+    return n.count;
+  }
+  EXPECT_GT(n.offset, node + 1);
+  EXPECT_LT(n.offset, nodes.size());
+  EXPECT_LT(n.axis, 3);
+  for (uint32_t c : {node + 1, n.offset}) {
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_LE(n.lo[a], nodes[c].lo[a]);
+      EXPECT_GE(n.hi[a], nodes[c].hi[a]);
+    }
+  }
+  return check_layout(bvh, node + 1, depth + 1, next_prim) + check_layout(bvh, n.offset, depth + 1, next_prim);
+}
+
+TEST(Bvh, FlatLayoutInvariants) {
+  Pcg32 rng(8);
+  const auto tris = test::random_triangles(rng, 20000);
+  const auto spheres = test::random_spheres(rng, 30);
+  const Bvh bvh = Bvh::build(tris, spheres);
+  uint32_t next = 0;
+  EXPECT_EQ(check_layout(bvh, 0, 0, next), tris.size() + spheres.size());
+  std::vector<uint32_t> order = bvh.prim_order();
+  std::sort(order.begin(), order.end());
+  for (uint32_t i = 0; i < order.size(); ++i) ASSERT_EQ(order[i], i);
+  const BvhStats s = bvh.stats();
+  EXPECT_EQ(s.nodes, bvh.nodes().size());
+  EXPECT_EQ(s.primitives, tris.size() + spheres.size());
+  EXPECT_EQ(s.leaves * 2 - 1, s.nodes);
+  EXPECT_GT(s.sah_cost, 1.0);
+}
+
+Bvh build_in_arena(int threads, const std::vector<Triangle>& tris, const std::vector<SpherePrim>& spheres) {
+  tbb::task_arena arena(threads);
+  Bvh bvh;
+  arena.execute([&] { bvh = Bvh::build(tris, spheres); });
+  return bvh;
+}
+
+TEST(Bvh, BuildIsDeterministicAcrossThreadCounts) {
+  Pcg32 rng(9);
+  auto tris = test::random_triangles(rng, 120000);
+  // A block of identical centroids inside a large node exercises the median fallback in parallel.
+  for (size_t i = 0; i < 6000; ++i) tris.push_back({Vec3(1, 2, 3), Vec3(2, 2, 3), Vec3(1, 3, 3 + 1e-3f * float(i % 7))});
+  const auto spheres = test::random_spheres(rng, 100);
+  const Bvh one = build_in_arena(1, tris, spheres);
+  ASSERT_GT(one.nodes().size(), 1000u);
+  for (int threads : {2, 4}) {
+    const Bvh other = build_in_arena(threads, tris, spheres);
+    ASSERT_EQ(one.nodes().size(), other.nodes().size()) << threads << " threads";
+    EXPECT_EQ(0, std::memcmp(one.nodes().data(), other.nodes().data(), one.nodes().size() * sizeof(BvhNode)))
+        << threads << " threads";
+    EXPECT_EQ(one.prim_order(), other.prim_order()) << threads << " threads";
+  }
+}
+
+}  // namespace
+}  // namespace tessera
