@@ -64,6 +64,32 @@ TEST(Offset, NoSelfHitUnitScale) { check_no_self_hit(Vec3(1.5f, -2.f, 0.7f), 2.f
 TEST(Offset, NoSelfHitFarFromOrigin) { check_no_self_hit(Vec3(1e4f, -3.5e3f, 8e3f), 5.f, 23); }
 TEST(Offset, NoSelfHitVeryFarFromOrigin) { check_no_self_hit(Vec3(-2e5f, 1e5f, -7e4f), 50.f, 24); }
 
+TEST(Offset, SphereSpawnedRaysLeaveTheSurface) {
+  // Hit points reprojected onto the sphere (as a shape does); rays leaving outwards must not hit the
+  // sphere again, rays going inwards must reach the far side, not the surface they start on.
+  Pcg32 rng(26);
+  for (const SpherePrim s : {SpherePrim{Vec3(0.1f, 0.2f, -0.3f), 1.f}, SpherePrim{Vec3(1e4f, -2e3f, 5e3f), 3.f},
+                             SpherePrim{Vec3(0.f), 0.01f}}) {
+    const Bvh bvh = Bvh::build({}, {s});
+    size_t bad = 0, tried = 0;
+    for (int i = 0; i < 2000; ++i) {
+      const Vec3 o = s.center + test::random_unit(rng) * (s.radius * 4.f);
+      const Vec3 aim = s.center + test::random_in_box(rng, -0.5f * s.radius, 0.5f * s.radius);
+      Hit hit;
+      if (!bvh.intersect(Ray{o, normalize(aim - o)}, hit)) continue;
+      const Vec3 n = normalize(o + normalize(aim - o) * hit.t - s.center);
+      const Vec3 p = s.center + n * s.radius;
+      Vec3 d = test::random_unit(rng);
+      ++tried;
+      Hit again;
+      const bool h = bvh.intersect(spawn_ray(p, n, d), again);
+      if (dot(d, n) > 0.f ? h : (!h || again.t < 1e-3f * s.radius)) ++bad;
+    }
+    EXPECT_GT(tried, 1000u);
+    EXPECT_EQ(bad, 0u) << "sphere at " << s.center.x << " radius " << s.radius;
+  }
+}
+
 TEST(Offset, WithoutOffsetSelfHitsHappen) {
   // The check above must be able to fail: spawning from the raw hit point does re-hit, far away.
   Pcg32 rng(25);

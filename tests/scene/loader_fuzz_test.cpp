@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -20,7 +21,13 @@
 namespace tessera {
 namespace {
 
-constexpr int kIterations = 12000;
+constexpr int kDefaultIterations = 12000;
+
+/// TESSERA_FUZZ_ITERATIONS / TESSERA_FUZZ_SEED let a longer hunt run locally; CI uses the defaults.
+uint64_t env_or(const char* name, uint64_t def) {
+  const char* v = std::getenv(name);
+  return v && *v ? std::strtoull(v, nullptr, 10) : def;
+}
 
 struct Rng {
   uint64_t state;
@@ -180,7 +187,8 @@ TEST(LoaderFuzz, MutatedRealScenesNeverCrash) {
     sc.text = read_file(sc.path);
     total_weight += sc.weight;
   }
-  Rng rng{20240607};
+  const int kIterations = int(env_or("TESSERA_FUZZ_ITERATIONS", kDefaultIterations));
+  Rng rng{env_or("TESSERA_FUZZ_SEED", 20240607)};
   int parsed = 0, loaded = 0, scene_errors = 0;
   for (int it = 0; it < kIterations; ++it) {
     size_t pick = rng.below(size_t(total_weight));

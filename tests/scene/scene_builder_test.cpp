@@ -372,6 +372,47 @@ TEST(SceneBuilder, AllowUnsupportedSubstitutesFallbacks) {
   EXPECT_TRUE(r.scene->lights.empty());  // the made-up emitter is dropped
 }
 
+TEST(SceneBuilder, UnsupportedSensorFilterIntegratorAndInstancedEmitter) {
+  const std::string body = R"(<integrator type="bdpt"><integer name="max_depth" value="4"/></integrator>
+<sensor type="thinlens"><float name="fov" value="30"/><float name="aperture_radius" value="0.1"/>
+  <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/>
+    <rfilter type="mitchell"/></film>
+  <sampler type="made_up_sampler"><integer name="sample_count" value="9"/></sampler>
+</sensor>
+<shape type="shapegroup" id="g">
+  <shape type="sphere"><emitter type="area"><rgb name="radiance" value="1"/></emitter></shape>
+</shape>
+<shape type="instance"><ref id="g"/></shape>
+<shape type="instance"><ref id="g"/></shape>)";
+  std::vector<UnsupportedItem> items;
+  try {
+    load(body);
+  } catch (const UnsupportedError& e) {
+    items = e.items();
+  }
+  std::vector<std::pair<int, std::string>> expected = {{2, "integrator 'bdpt'"},
+                                                       {3, "sensor 'thinlens'"},
+                                                       {5, "rfilter 'mitchell'"},
+                                                       {6, "sampler 'made_up_sampler'"},
+                                                       {9, "area emitter inside a shapegroup"}};
+  ASSERT_EQ(items.size(), expected.size());
+  for (const auto& [line, what] : expected) {
+    bool found = false;
+    for (const auto& it : items) found |= it.loc.line == line && it.what.find(what) != std::string::npos;
+    EXPECT_TRUE(found) << line << " " << what;
+  }
+  LoadOptions opt;
+  opt.allow_unsupported = true;
+  LoadResult r = load(body, opt);
+  EXPECT_EQ(r.scene->integrator.type, IntegratorType::Path);
+  EXPECT_EQ(r.scene->film.filter->name(), "gaussian");
+  EXPECT_EQ(r.scene->sampler.type, SamplerType::Independent);
+  EXPECT_EQ(r.scene->sampler.sample_count, 9);
+  EXPECT_EQ(r.scene->shapes.size(), 2u);
+  EXPECT_TRUE(r.scene->lights.empty());
+  EXPECT_NE(r.scene->camera, nullptr);
+}
+
 TEST(SceneBuilder, UnreferencedDefinitionsAreNotReported) {
   // As in the bathroom scene: a top-level bumpmap nobody uses, whose inner BSDF has the id.
   LoadResult r = load(std::string(kCamera) + R"(

@@ -277,6 +277,25 @@ TEST(XmlParser, OldVersionNamesAreSnakeCased) {
   EXPECT_TRUE(c[4]->named_child("diffuse_reflectance")->has("filter_type"));
 }
 
+TEST(XmlParser, OldUvOffsetAndScaleBecomeToUv) {
+  auto d = parse(R"(<texture type="bitmap">
+  <float name="uscale" value="2"/><float name="vscale" value="4"/>
+  <float name="uoffset" value="0.5"/>
+</texture>)",
+                 "0.6.0");
+  const SceneNode& t = *d.root->children[0];
+  EXPECT_FALSE(t.has("uscale"));
+  ASSERT_TRUE(t.has("to_uv"));
+  // Mitsuba 0.6: uv' = uv * scale + offset.
+  Vec3 uv = t.get_transform("to_uv", {}).apply_point(Vec3(1.f, 1.f, 0.f));
+  EXPECT_FLOAT_EQ(uv.x, 2.5f);
+  EXPECT_FLOAT_EQ(uv.y, 4.f);
+  EXPECT_EQ(prop(t, "to_uv").loc.line, 3);
+  // Mitsuba 3 scenes keep their parameters as written.
+  auto d3 = parse("<texture type=\"bitmap\"><float name=\"uscale\" value=\"2\"/></texture>");
+  EXPECT_TRUE(d3.root->children[0]->has("uscale"));
+}
+
 TEST(XmlParser, NewVersionNamesAreKept) {
   auto d = parse(R"(<integrator type="path"><integer name="max_depth" value="5"/>
   <integer name="maxDepth" value="6"/></integrator>)",

@@ -84,6 +84,7 @@ class Builder {
   uint32_t build_serial(size_t begin, size_t end, int depth, std::vector<BvhNode>& out) {
     const size_t n = end - begin;
     const RangeBounds rb = compute_range_bounds(refs_ + begin, n, false);
+    TESSERA_DCHECK(depth < kMaxDepth + 4);  // the traversal stack holds 64 entries
     const uint32_t index = uint32_t(out.size());
     out.push_back(make_node(rb.bounds));
     const Decision d = decide(begin, end, depth, rb, false);

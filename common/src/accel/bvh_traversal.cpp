@@ -2,13 +2,18 @@
 //
 // At an interior node both children's boxes are tested; the nearer hit child (by box entry
 // distance) is visited first and the other pushed with its entry distance, so a popped subtree
-// entered beyond the closest hit so far is skipped without touching its node.
+// entered beyond the closest hit so far is skipped without touching its node. (Ordering by the
+// direction's sign on the node's split axis needs no comparison, but once both boxes are tested the
+// entry distances are free, order better, and make the pop-time culling possible; on the bathroom
+// rays this was as fast for primary rays and about 5% faster for diffuse and shadow rays.)
 // The slab test is the robust one of Ize, "Robust BVH Ray Traversal" (JCGT 2013), as in pbrt-v4:
 // each slab distance carries at most three roundings, so scaling the exit distance by 1 + 2 gamma(3)
 // keeps every box the ray truly crosses, and a watertight triangle hit is never culled by its box.
 #include "accel/intersect_inline.h"
 #include "tessera/accel/bvh.h"
 #include "tessera/core/check.h"
+
+#include <cstddef>
 
 namespace tessera {
 using namespace accel_detail;
@@ -18,26 +23,40 @@ namespace {
 constexpr int kStackSize = 64;
 constexpr float kExitScale = 1.f + 2.f * gamma(3);
 
-/// Reciprocal that never produces inf: a zero (or denormal) direction component becomes +-1e30,
-/// so (plane - origin) * inv is never 0 * inf = NaN. A box plane containing an axis-parallel ray
-/// then counts as crossed, which is conservative.
-inline float safe_rcp(float d) {
-  constexpr float kTiny = 1e-30f;
-  return std::abs(d) < kTiny ? std::copysign(1.f / kTiny, d) : 1.f / d;
-}
-
+/// Per-ray constants of the slab test. The sign of each direction component decides which of
+/// a box's two planes the ray meets first, so the test reads the near and far plane directly instead
+/// of ordering the two slab distances with min/max.
 struct BoxRay {
   Vec3 o, inv;
+  int near[3], far[3];  // index of the near/far plane coordinate in the node's floats (see below)
 };
 
+// A node read as floats: lo.x lo.y lo.z [offset] hi.x hi.y hi.z [count, axis, pad].
+static_assert(offsetof(BvhNode, lo) == 0 && offsetof(BvhNode, hi) == 4 * sizeof(float));
+
+inline BoxRay make_box_ray(const Ray& ray) {
+  BoxRay r{ray.o, Vec3(1.f / ray.d.x, 1.f / ray.d.y, 1.f / ray.d.z), {}, {}};
+  for (int a = 0; a < 3; ++a) {
+    r.near[a] = r.inv[a] < 0.f ? 4 + a : a;
+    r.far[a] = r.inv[a] < 0.f ? a : 4 + a;
+  }
+  return r;
+}
+
 /// True when the node box overlaps the ray segment [tmin, tmax]; `tnear` gets the entry distance.
+///
+/// A zero direction component has an infinite reciprocal, and its slab distance is 0 * inf = NaN
+/// when the origin lies exactly on that slab's plane (the ray runs inside the plane). std::max(a, b)
+/// is (a < b) ? b : a and std::min(a, b) is (b < a) ? b : a, so with tmin and tmax (never NaN)
+/// taking part as below, a NaN is dropped rather than propagated; it may take one other slab with
+/// it, which only makes the test more conservative.
 inline bool hit_box(const BvhNode& n, const BoxRay& r, float tmin, float tmax, float& tnear) {
-  const float tx0 = (n.lo.x - r.o.x) * r.inv.x, tx1 = (n.hi.x - r.o.x) * r.inv.x;
-  const float ty0 = (n.lo.y - r.o.y) * r.inv.y, ty1 = (n.hi.y - r.o.y) * r.inv.y;
-  const float tz0 = (n.lo.z - r.o.z) * r.inv.z, tz1 = (n.hi.z - r.o.z) * r.inv.z;
-  const float t0 = std::max(std::max(tmin, std::min(tx0, tx1)),
-                            std::max(std::min(ty0, ty1), std::min(tz0, tz1)));
-  const float exit = std::min(std::max(tx0, tx1), std::min(std::max(ty0, ty1), std::max(tz0, tz1)));
+  const float* f = &n.lo.x;
+  const float tx0 = (f[r.near[0]] - r.o.x) * r.inv.x, tx1 = (f[r.far[0]] - r.o.x) * r.inv.x;
+  const float ty0 = (f[r.near[1]] - r.o.y) * r.inv.y, ty1 = (f[r.far[1]] - r.o.y) * r.inv.y;
+  const float tz0 = (f[r.near[2]] - r.o.z) * r.inv.z, tz1 = (f[r.far[2]] - r.o.z) * r.inv.z;
+  const float t0 = std::max(std::max(tmin, tx0), std::max(ty0, tz0));
+  const float exit = std::min(tx1, std::min(ty1, tz1));
   const float t1 = std::min(tmax, exit * kExitScale);
   tnear = t0;
   return t0 <= t1;
@@ -54,10 +73,18 @@ struct BvhView {
   bool triangles_only;
 };
 
+/// A hit leaf child's triangles will be needed soon: start loading them while the traversal goes
+/// on (a few percent faster on the bathroom rays, where the tree does not fit in cache).
+inline void prefetch_leaf(const BvhView& v, const BvhNode& n) {
+  if (n.count == 0) return;
+  __builtin_prefetch(&v.tris[n.offset]);
+  __builtin_prefetch(&v.tris[n.offset + n.count - 1][2]);
+}
+
 template <int kz, bool kAnyHit>
 bool traverse(const BvhView& v, const Ray& ray, Hit& hit) {
   const WatertightRay wr = WatertightRay::make<kz>(ray);
-  const BoxRay br{ray.o, Vec3(safe_rcp(ray.d.x), safe_rcp(ray.d.y), safe_rcp(ray.d.z))};
+  const BoxRay br = make_box_ray(ray);
   const float tmin = ray.tmin;
   float tmax = ray.tmax;
   float tnear;
@@ -78,6 +105,8 @@ bool traverse(const BvhView& v, const Ray& ray, Hit& hit) {
       float ta, tb;
       const bool hit_a = hit_box(v.nodes[a], br, tmin, tmax, ta);
       const bool hit_b = hit_box(v.nodes[b], br, tmin, tmax, tb);
+      if (hit_a) prefetch_leaf(v, v.nodes[a]);
+      if (hit_b) prefetch_leaf(v, v.nodes[b]);
       if (hit_a && hit_b) {
         if (tb < ta) {
           std::swap(a, b);

@@ -2,6 +2,8 @@
 
 #include <tbb/parallel_for.h>
 
+#include <emmintrin.h>
+
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -9,84 +11,113 @@
 namespace tessera::accel_detail {
 namespace {
 
-/// One bin: bounds of its primitives and their number. Plain floats, so an array of bins is not
-/// initialised behind our back (Bounds3 and Vec3 have default initialisers).
-struct Bin {
-  float lo[3], hi[3];
-  uint32_t count;
-  void reset() {
-    for (int a = 0; a < 3; ++a) lo[a] = kInfinity, hi[a] = -kInfinity;
-    count = 0;
+// Binning dominates the build, so it is written with SSE2 (part of the x86-64 baseline: no extra
+// compiler flags). Lane 3 of every vector is unused; it is masked to zero on load so that the
+// primitive index stored beside the bounds never takes part in arithmetic.
+const __m128 kXyzMask = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0));
+
+inline __m128 load_xyz(const Vec3& v) { return _mm_and_ps(_mm_loadu_ps(&v.x), kXyzMask); }
+
+struct Box4 {
+  __m128 lo = _mm_set1_ps(kInfinity), hi = _mm_set1_ps(-kInfinity);
+  void extend(__m128 l, __m128 h) {
+    lo = _mm_min_ps(lo, l);
+    hi = _mm_max_ps(hi, h);
   }
-  void add(const PrimRef& r) {
-    lo[0] = std::min(lo[0], r.lo.x), lo[1] = std::min(lo[1], r.lo.y), lo[2] = std::min(lo[2], r.lo.z);
-    hi[0] = std::max(hi[0], r.hi.x), hi[1] = std::max(hi[1], r.hi.y), hi[2] = std::max(hi[2], r.hi.z);
-    ++count;
+  void extend(const Box4& b) { extend(b.lo, b.hi); }
+  /// Surface area; zero when empty.
+  float area() const {
+    alignas(16) float d[4];
+    _mm_store_ps(d, _mm_sub_ps(hi, lo));
+    if (d[0] < 0.f) return 0.f;
+    return 2.f * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0]);
   }
-  void merge(const Bin& o) {
-    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], o.lo[a]), hi[a] = std::max(hi[a], o.hi[a]);
-    count += o.count;
+  Bounds3 bounds() const {
+    alignas(16) float l[4], h[4];
+    _mm_store_ps(l, lo);
+    _mm_store_ps(h, hi);
+    return Bounds3{Vec3(l[0], l[1], l[2]), Vec3(h[0], h[1], h[2])};
   }
 };
 
 /// Per-axis bins; only the first `n` of each axis are initialised and used.
 struct Bins {
-  Bin bin[3][kNumBins];
-  explicit Bins(int n = kNumBins) {
+  Box4 box[3][kNumBins];
+  uint32_t count[3][kNumBins];
+  explicit Bins(int n) {
     for (int axis = 0; axis < 3; ++axis)
-      for (int b = 0; b < n; ++b) bin[axis][b].reset();
+      for (int b = 0; b < n; ++b) {
+        box[axis][b] = Box4{};
+        count[axis][b] = 0;
+      }
   }
 };
 
 void bin_range(const PrimRef* refs, size_t begin, size_t end, const BinMapper& m, Bins& bins) {
+  const __m128 lo = _mm_setr_ps(m.lo[0], m.lo[1], m.lo[2], 0.f);
+  const __m128 scale = _mm_setr_ps(m.scale[0], m.scale[1], m.scale[2], 0.f);
+  const __m128 zero = _mm_setzero_ps(), half = _mm_set1_ps(0.5f);
+  const __m128 last = _mm_set1_ps(float(m.num_bins - 1));
+  alignas(16) int32_t b[4];
   for (size_t i = begin; i < end; ++i) {
-    const PrimRef& r = refs[i];
-    const Vec3 c = r.centroid();
-    for (int axis = 0; axis < 3; ++axis)
-      if (m.usable[axis]) bins.bin[axis][m.bin(c, axis)].add(r);
+    const __m128 plo = load_xyz(refs[i].lo), phi = load_xyz(refs[i].hi);
+    // Same arithmetic as BinMapper::bin, lane by lane.
+    const __m128 c = _mm_mul_ps(_mm_add_ps(plo, phi), half);
+    const __m128 f = _mm_min_ps(_mm_max_ps(_mm_mul_ps(_mm_sub_ps(c, lo), scale), zero), last);
+    _mm_store_si128(reinterpret_cast<__m128i*>(b), _mm_cvttps_epi32(f));
+    for (int axis = 0; axis < 3; ++axis) {
+      bins.box[axis][b[axis]].extend(plo, phi);
+      ++bins.count[axis][b[axis]];
+    }
   }
 }
 
 void merge_into(Bins& into, const Bins& from, int n) {
   for (int axis = 0; axis < 3; ++axis)
-    for (int b = 0; b < n; ++b) into.bin[axis][b].merge(from.bin[axis][b]);
-}
-
-/// Surface area of a box given as accumulated lo/hi (zero when empty).
-float area(const float lo[3], const float hi[3]) {
-  const float dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
-  if (dx < 0.f) return 0.f;
-  return 2.f * (dx * dy + dy * dz + dz * dx);
+    for (int b = 0; b < n; ++b) {
+      into.box[axis][b].extend(from.box[axis][b]);
+      into.count[axis][b] += from.count[axis][b];
+    }
 }
 
 size_t num_chunks(size_t n) { return (n + kReduceChunk - 1) / kReduceChunk; }
 
+struct RangeBox {
+  Box4 bounds, centroids;
+};
+
+RangeBox reduce_range(const PrimRef* refs, size_t begin, size_t end) {
+  RangeBox rb;
+  const __m128 half = _mm_set1_ps(0.5f);
+  for (size_t i = begin; i < end; ++i) {
+    const __m128 plo = load_xyz(refs[i].lo), phi = load_xyz(refs[i].hi);
+    const __m128 c = _mm_mul_ps(_mm_add_ps(plo, phi), half);
+    rb.bounds.extend(plo, phi);
+    rb.centroids.extend(c, c);
+  }
+  return rb;
+}
+
 }  // namespace
 
 RangeBounds compute_range_bounds(const PrimRef* refs, size_t n, bool parallel) {
-  auto reduce = [refs](size_t begin, size_t end) {
-    RangeBounds rb;
-    for (size_t i = begin; i < end; ++i) {
-      rb.bounds.lo = vmin(rb.bounds.lo, refs[i].lo);
-      rb.bounds.hi = vmax(rb.bounds.hi, refs[i].hi);
-      rb.centroids.extend(refs[i].centroid());
+  RangeBox rb;
+  if (!parallel || n <= kReduceChunk) {
+    rb = reduce_range(refs, 0, n);
+  } else {
+    // Fixed chunks, merged in chunk order: the result does not depend on the thread count (min/max
+    // are exact, but the sign of a zero could depend on the merge order).
+    const size_t chunks = num_chunks(n);
+    std::vector<RangeBox> partial(chunks);
+    tbb::parallel_for(size_t(0), chunks, [&](size_t k) {
+      partial[k] = reduce_range(refs, k * kReduceChunk, std::min(n, (k + 1) * kReduceChunk));
+    });
+    for (const RangeBox& p : partial) {
+      rb.bounds.extend(p.bounds);
+      rb.centroids.extend(p.centroids);
     }
-    return rb;
-  };
-  if (!parallel || n <= kReduceChunk) return reduce(0, n);
-  // Fixed chunks, merged in chunk order: the result does not depend on the thread count (min/max
-  // are exact, but the sign of a zero could depend on the merge order).
-  const size_t chunks = num_chunks(n);
-  std::vector<RangeBounds> partial(chunks);
-  tbb::parallel_for(size_t(0), chunks, [&](size_t k) {
-    partial[k] = reduce(k * kReduceChunk, std::min(n, (k + 1) * kReduceChunk));
-  });
-  RangeBounds rb;
-  for (const RangeBounds& p : partial) {
-    rb.bounds.extend(p.bounds);
-    rb.centroids.extend(p.centroids);
   }
-  return rb;
+  return {rb.bounds.bounds(), rb.centroids.bounds()};
 }
 
 BinMapper::BinMapper(const Bounds3& centroids, int bins) : num_bins(bins) {
@@ -95,6 +126,7 @@ BinMapper::BinMapper(const Bounds3& centroids, int bins) : num_bins(bins) {
     lo[axis] = centroids.lo[axis];
     scale[axis] = extent > 0.f ? float(bins) / extent : 0.f;
     usable[axis] = extent > 0.f && std::isfinite(scale[axis]) && std::isfinite(extent);
+    if (!usable[axis]) scale[axis] = 0.f;  // every centroid in bin 0
   }
 }
 
@@ -121,18 +153,21 @@ SahSplit find_sah_split(const PrimRef* refs, size_t n, const Bounds3& bounds, co
     // right_cost[b]: n_R * SA(R) for the primitives in bins b+1 .. end.
     float right_cost[kNumBins];
     uint32_t right_count[kNumBins];
-    Bin acc;
-    acc.reset();
+    Box4 acc;
+    uint32_t count = 0;
     for (int b = nb - 1; b > 0; --b) {
-      acc.merge(bins.bin[axis][b]);
-      right_cost[b - 1] = float(acc.count) * area(acc.lo, acc.hi);
-      right_count[b - 1] = acc.count;
+      acc.extend(bins.box[axis][b]);
+      count += bins.count[axis][b];
+      right_cost[b - 1] = float(count) * acc.area();
+      right_count[b - 1] = count;
     }
-    acc.reset();
+    acc = Box4{};
+    count = 0;
     for (int b = 0; b + 1 < nb; ++b) {
-      acc.merge(bins.bin[axis][b]);
-      if (acc.count == 0 || right_count[b] == 0) continue;
-      const float cost = kTraversalCost + (float(acc.count) * area(acc.lo, acc.hi) + right_cost[b]) * inv_area;
+      acc.extend(bins.box[axis][b]);
+      count += bins.count[axis][b];
+      if (count == 0 || right_count[b] == 0) continue;
+      const float cost = kTraversalCost + (float(count) * acc.area() + right_cost[b]) * inv_area;
       if (!best.valid || cost < best.cost) best = SahSplit{true, axis, b, cost};
     }
   }

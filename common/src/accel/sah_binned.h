@@ -23,7 +23,7 @@ inline constexpr size_t kParallelThreshold = 4096;
 inline constexpr size_t kReduceChunk = 2048;
 
 /// A primitive as the builder sees it: its bounds and global index. 32 bytes.
-struct PrimRef {
+struct alignas(16) PrimRef {
   Vec3 lo;
   uint32_t prim;
   Vec3 hi;
@@ -52,10 +52,13 @@ struct BinMapper {
   bool usable[3];  // the centroid extent along the axis is non-zero and finite
   int num_bins;
   BinMapper(const Bounds3& centroids, int bins);
+  /// Bin of centroid `c` on `axis`; the clamping mirrors the SSE binning loop bit for bit.
   int bin(Vec3 c, int axis) const {
     float f = (c[axis] - lo[axis]) * scale[axis];
-    int b = int(f);
-    return b < 0 ? 0 : (b >= num_bins ? num_bins - 1 : b);
+    f = f > 0.f ? f : 0.f;
+    const float last = float(num_bins - 1);
+    f = f < last ? f : last;
+    return int(f);
   }
 };
 

@@ -1,36 +1,80 @@
+// Mitsuba's `area` emitter: constant radiance leaving the front (geometric-normal) side of a shape.
+//
+// Sampling: by area on the shape, converted to solid angle (pdf_area d^2 / |cos at the light|).
+// Spheres seen from outside instead sample the cone of directions they subtend (pbrt-v4's
+// Sphere::Sample): every sample lands on the visible cap, where uniform area sampling would waste
+// the half of its samples that fall on the hidden side, and the density is smooth.
 #include "tessera/light/area.h"
 
+#include "tessera/core/frame.h"
+#include "tessera/core/sampling.h"
 #include "tessera/scene/load_context.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace tessera {
 namespace {
 
+// Below sin^2(theta_max) ~ sin^2(1.5 deg) the cone's 1 - cos(theta_max) loses all precision in
+// float; a first-order expansion in sin^2 replaces it (as pbrt-v4 does).
+constexpr float kSmallCone = 0.00068523f;
+
+struct Cone {
+  float sin2_max = 0.f, cos_max = 1.f, one_minus_cos_max = 0.f;
+};
+
+inline Cone sphere_cone(float dist2_center, float radius) {
+  Cone c;
+  c.sin2_max = std::min(1.f, radius * radius / dist2_center);
+  c.cos_max = std::sqrt(std::max(0.f, 1.f - c.sin2_max));
+  c.one_minus_cos_max = c.sin2_max < kSmallCone ? 0.5f * c.sin2_max : 1.f - c.cos_max;
+  return c;
+}
+
 class AreaLight final : public Light {
  public:
-  AreaLight(const Shape& shape, Rgb radiance) : shape_(shape), radiance_(radiance) {}
+  AreaLight(const Shape& shape, Rgb radiance) : shape_(shape), radiance_(radiance) {
+    if (shape.kind() == Shape::Kind::Sphere) {
+      sphere_ = static_cast<const SphereShape*>(&shape);
+      // Whether the sphere's normals are flipped is not part of the Shape interface; the normal
+      // sample_area returns tells it (outward unless flipped).
+      Vec3 p, n;
+      float pdf = 0.f;
+      shape.sample_area({0.3f, 0.6f}, p, n, pdf);
+      sphere_flipped_ = dot(n, p - sphere_->center()) < 0.f;
+    }
+  }
 
   bool sample_li(Vec3 ref_p, Vec2 u, LightSample& out) const override {
     Vec3 p, n;
-    float pdf_area = 0.f;
-    shape_.sample_area(u, p, n, pdf_area);
+    float pdf = 0.f;
+    const bool cone = sphere_ && outside_sphere(ref_p);
+    if (cone) {
+      if (!sample_sphere_cone(ref_p, u, p, n, pdf)) return false;
+    } else {
+      float pdf_area = 0.f;
+      shape_.sample_area(u, p, n, pdf_area);
+      if (!(pdf_area > 0.f)) return false;
+      pdf = pdf_area;  // converted below, once the distance is known
+    }
     Vec3 d = p - ref_p;
     float dist2 = length_squared(d);
-    if (!(dist2 > 0.f) || !(pdf_area > 0.f)) return false;
+    if (!(dist2 > 0.f)) return false;
     float dist = std::sqrt(dist2);
     Vec3 wi = d / dist;
     // Emission is one-sided: a point seen from behind contributes nothing.
     float cos_light = -dot(n, wi);
     if (!(cos_light > 0.f)) return false;
+    if (!cone) pdf *= dist2 / cos_light;
     out.wi = wi;
     out.li = radiance_;
     out.p_light = p;
     out.n_light = n;
     out.dist = dist;
-    out.pdf = pdf_area * dist2 / cos_light;
+    out.pdf = pdf;
     out.delta = false;
-    return std::isfinite(out.pdf);
+    return std::isfinite(pdf) && pdf > 0.f;
   }
 
   Rgb le(const SurfaceInteraction& si, Vec3 w) const override {
@@ -38,6 +82,10 @@ class AreaLight final : public Light {
   }
 
   float pdf_li(Vec3 ref_p, const SurfaceInteraction& si) const override {
+    if (sphere_ && outside_sphere(ref_p)) {
+      Cone c = sphere_cone(length_squared(sphere_->center() - ref_p), sphere_->radius());
+      return 1.f / (2.f * kPi * c.one_minus_cos_max);
+    }
     Vec3 d = si.p - ref_p;
     float dist2 = length_squared(d);
     if (!(dist2 > 0.f)) return 0.f;
@@ -48,10 +96,50 @@ class AreaLight final : public Light {
     return std::isfinite(pdf) ? pdf : 0.f;
   }
 
-  float power() const override { return kPi * shape_.area() * radiance_.average(); }
+  float power() const override { return kPi * shape_.area() * radiance_.luminance(); }
 
  private:
+  bool outside_sphere(Vec3 ref_p) const {
+    float r = sphere_->radius();
+    // A reference point on the sphere itself (e.g. a hit on the light) counts as inside: the
+    // cone degenerates to a hemisphere there.
+    return length_squared(ref_p - sphere_->center()) > r * r * 1.0001f;
+  }
+
+  bool sample_sphere_cone(Vec3 ref_p, Vec2 u, Vec3& p, Vec3& n, float& pdf) const {
+    const Vec3 c = sphere_->center();
+    const float r = sphere_->radius();
+    const Vec3 to_center = c - ref_p;
+    const float dc2 = length_squared(to_center);
+    const Cone cone = sphere_cone(dc2, r);
+    // Direction in the cone around the centre direction, theta measured from it.
+    float sin2_theta, cos_theta;
+    if (cone.sin2_max < kSmallCone) {
+      sin2_theta = cone.sin2_max * u.x;
+      cos_theta = std::sqrt(1.f - sin2_theta);
+    } else {
+      cos_theta = (1.f - u.x) + u.x * cone.cos_max;
+      sin2_theta = std::max(0.f, 1.f - cos_theta * cos_theta);
+    }
+    // Angle alpha at the centre between -to_center and the hit point (first intersection).
+    const float sin_theta_max = std::sqrt(cone.sin2_max);
+    float cos_alpha = sin2_theta / sin_theta_max +
+                      cos_theta * std::sqrt(std::max(0.f, 1.f - sin2_theta / cone.sin2_max));
+    cos_alpha = std::clamp(cos_alpha, -1.f, 1.f);
+    const float sin_alpha = std::sqrt(std::max(0.f, 1.f - cos_alpha * cos_alpha));
+    const float phi = 2.f * kPi * u.y;
+    const Frame frame(to_center / std::sqrt(dc2));
+    // Outward normal at the sampled point, in the frame whose +z points from ref to the centre.
+    const Vec3 n_out = frame.to_world(Vec3(-sin_alpha * std::cos(phi), -sin_alpha * std::sin(phi), -cos_alpha));
+    p = c + n_out * r;
+    n = sphere_flipped_ ? -n_out : n_out;
+    pdf = 1.f / (2.f * kPi * cone.one_minus_cos_max);
+    return std::isfinite(pdf);
+  }
+
   const Shape& shape_;
+  const SphereShape* sphere_ = nullptr;
+  bool sphere_flipped_ = false;
   Rgb radiance_;
 };
 

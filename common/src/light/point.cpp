@@ -25,7 +25,7 @@ class PointLight final : public Light {
   }
 
   bool is_delta() const override { return true; }
-  float power() const override { return 4.f * kPi * intensity_.average(); }
+  float power() const override { return 4.f * kPi * intensity_.luminance(); }
 
  private:
   Vec3 position_;

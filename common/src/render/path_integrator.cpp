@@ -1,3 +1,6 @@
+// Unidirectional path tracer (see integrator.h): next-event estimation and BSDF sampling at each
+// vertex, combined with the power heuristic; emitters hit by BSDF-sampled rays are weighted against
+// the light-sampling density at the previous vertex (pdf_li or pdf_env times the selection pmf).
 #include "tessera/core/frame.h"
 #include "tessera/core/sampling.h"
 #include "tessera/render/integrator.h"
@@ -75,6 +78,8 @@ class PathIntegrator final : public Integrator {
       prev_p = si.p;
       ++depth;
 
+      // Russian roulette as Mitsuba 3: survival probability from the throughput, times eta^2 so that
+      // refraction's radiance scaling does not kill paths inside glass early; capped at 0.95.
       if (depth >= s_.rr_depth) {
         float q = std::min(throughput.max_value() * eta * eta, 0.95f);
         if (!(u_rr < q)) break;

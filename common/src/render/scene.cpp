@@ -51,6 +51,7 @@ void Scene::finalize() {
   std::vector<float> power;
   power.reserve(lights.size());
   for (auto& l : lights) {
+    l->scene_index = uint32_t(&l - lights.data());
     l->preprocess(b);
     if (l->is_infinite()) infinite_lights_.push_back(l.get());
     power.push_back(std::max(l->power(), 0.f));
@@ -79,10 +80,8 @@ const Light* Scene::sample_light(float u, float& pmf) const {
 }
 
 float Scene::light_pmf(const Light* light) const {
-  // Lights are few; a linear scan keeps the Light interface free of scene bookkeeping.
-  for (size_t i = 0; i < lights.size(); ++i)
-    if (lights[i].get() == light) return light_distr_.pmf(uint32_t(i));
-  return 0.f;
+  if (!light || light->scene_index >= lights.size() || lights[light->scene_index].get() != light) return 0.f;
+  return light_distr_.pmf(light->scene_index);
 }
 
 }  // namespace tessera

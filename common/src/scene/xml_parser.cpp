@@ -298,10 +298,46 @@ class Parser {
     if (const std::string* name = attrs.get("name"))
       node->name = xml::normalize_name(*name, src.version_major, parent.tag, parent.type);
     parse_children(src, el, *node, depth + 1);
+    if (src.version_major < 2) fold_uv_transform(*node);
     // Registered only now, so an object cannot refer to itself.
     if (!node->id.empty()) register_id(node->id, node, loc);
     parent.children.push_back(node);
     parent.child_names.push_back(node->name);
+  }
+
+  /// Mitsuba 0.x textures take uoffset/voffset/uscale/vscale; Mitsuba 3 one `to_uv` transform.
+  /// Folded with 0.6's meaning, uv' = uv * scale + offset (Mitsuba 3's own upgrade applies the
+  /// offset before the scale, which differs when both are given).
+  static void fold_uv_transform(SceneNode& node) {
+    static const char* const kNames[4] = {"uoffset", "voffset", "uscale", "vscale"};
+    double v[4] = {0, 0, 1, 1};
+    std::string written;
+    FileLoc loc;
+    bool any = false;
+    for (int i = 0; i < 4; ++i) {
+      const Property* p = node.find(kNames[i]);
+      if (!p) continue;
+      if (p->type != PropType::Float && p->type != PropType::Integer) return;  // the getter reports it
+      v[i] = p->type == PropType::Float ? p->f : double(p->i);
+      written += (written.empty() ? "" : "/") + p->written_name;
+      if (!any || p->loc.line < loc.line) loc = p->loc;
+      any = true;
+    }
+    if (!any || node.has("to_uv")) return;
+    Transform to_uv = Transform::translate(Vec3(float(v[0]), float(v[1]), 0.f)) *
+                      Transform::scale(Vec3(float(v[2]), float(v[3]), 1.f));
+    if (!Transform::from_matrix(to_uv.matrix()))
+      throw SceneError(loc, "uscale/vscale of " + node.describe() + " must be non-zero");
+    std::erase_if(node.props, [](const Property& p) {
+      return p.name == "uoffset" || p.name == "voffset" || p.name == "uscale" || p.name == "vscale";
+    });
+    Property prop;
+    prop.name = "to_uv";
+    prop.written_name = written;
+    prop.type = PropType::Transform;
+    prop.loc = loc;
+    prop.xf = to_uv;
+    node.props.push_back(std::move(prop));
   }
 
   void register_id(const std::string& id, const std::shared_ptr<SceneNode>& node, const FileLoc& loc) {

@@ -14,6 +14,8 @@
 #include "tessera/core/vec.h"
 #include "tessera/render/interaction.h"
 
+#include <cstdint>
+
 namespace tessera {
 
 struct LightSample {
@@ -47,6 +49,9 @@ class Light {
   virtual bool is_delta() const { return false; }
   /// Total emitted power (an estimate is fine); lights are picked in proportion to it.
   virtual float power() const = 0;
+
+  /// Position in Scene::lights, set by Scene::finalize() (light selection looks it up there).
+  uint32_t scene_index = 0;
 };
 
 }  // namespace tessera

@@ -31,11 +31,7 @@ class Sampler {
   Sampler(SamplerType type, uint32_t seed) : type_(type), seed_(seed) {}
 
   /// Positions the sampler at sample `index` of `pixel` (full-film raster pixel), dimension 0.
-  void start_pixel_sample(Vec2i pixel, uint32_t index) {
-    pixel_ = pixel;
-    index_ = index;
-    dim_ = 0;
-  }
+  void start_pixel_sample(Vec2i pixel, uint32_t index);
   /// Uniform in [0, 1).
   float next_1d();
   /// Uniform in [0, 1)^2.
@@ -46,11 +42,11 @@ class Sampler {
   uint32_t seed() const { return seed_; }
 
  private:
-  uint64_t dim_hash(uint32_t dim) const;
-
   SamplerType type_;
   uint32_t seed_;
-  Vec2i pixel_;
+  Vec2i pixel_{-1, -1};
+  uint64_t pixel_hash_ = 0;   // hash(pixel, seed), cached across the samples of a pixel
+  uint64_t sample_hash_ = 0;  // hash(pixel, index, seed), for the independent sampler
   uint32_t index_ = 0;
   uint32_t dim_ = 0;
 };

@@ -56,6 +56,10 @@ class LoadContext {
                                               const std::function<MeshData()>& load);
 
   /// Builds (once per node) the BSDF a shape refers to; null node -> the default diffuse BSDF.
+  /// texture() and bsdf() mark the nested node consumed; a factory that uses a nested node any
+  /// other way must set `node->used = true`, or the node is reported as unused.
+  /// An unsupported type yields the documented fallback (diffuse 0.5 / constant texture); the
+  /// final report lists it.
   const Bsdf* bsdf(const std::shared_ptr<SceneNode>& node);
 
   void note(const FileLoc& loc, const std::string& text);
