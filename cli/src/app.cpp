@@ -27,7 +27,9 @@ int main_entry(int argc, char** argv) {
   std::vector<std::string> defines;
   auto* r = app.add_subcommand("render", "Render a Mitsuba XML scene to EXR/PFM/PNG");
   r->add_option("scene", render.scene, "Scene file (Mitsuba XML 0.5/0.6 or 2.x/3.x)")->required();
-  r->add_option("-o,--output", render.outputs, "Output image(s): .exr, .pfm or .png")->required();
+  r->add_option("-o,--output", render.outputs,
+                "Output image(s): .exr, .pfm or .png (default: SCENE_STEM.exr in the current directory, "
+                "plus SCENE_STEM.png for an ldrfilm)");
   r->add_option("--spp", render.spp, "Samples per pixel (default: the scene's)")->check(CLI::PositiveNumber);
   r->add_option("--width", render.width, "Film width (default: the scene's)")->check(CLI::PositiveNumber);
   r->add_option("--height", render.height, "Film height (default: the scene's)")->check(CLI::PositiveNumber);

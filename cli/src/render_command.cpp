@@ -32,13 +32,23 @@ void print_messages(const LoadResult& result) {
               << m.text << "\n";
 }
 
+// Without -o: the scene's stem in the current directory (the scene's own folder may be read-only),
+// as EXR, plus PNG when the scene asked for an ldrfilm.
+std::vector<std::string> output_paths(const RenderOptions& options, const Scene& scene) {
+  if (!options.outputs.empty()) return options.outputs;
+  std::string stem = std::filesystem::path(options.scene).stem().string();
+  std::vector<std::string> outs = {stem + ".exr"};
+  if (scene.film.ldr) outs.push_back(stem + ".png");
+  return outs;
+}
+
 void write_outputs(const RenderOptions& options, const Scene& scene, const Film& film) {
   Image image = film.to_image();
   ImageAttributes attributes = {{"tessera_version", TESSERA_VERSION},
                                 {"tessera_scene", options.scene},
                                 {"tessera_spp", std::to_string(scene.sampler.sample_count)},
                                 {"tessera_seed", std::to_string(options.seed)}};
-  for (const auto& out : options.outputs) {
+  for (const auto& out : output_paths(options, scene)) {
     std::string ext = lower_extension(out);
     auto parent = std::filesystem::path(out).parent_path();
     if (!parent.empty()) std::filesystem::create_directories(parent);
@@ -91,11 +101,19 @@ int run_render(const RenderOptions& options) {
     settings.threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
     settings.tile_size = options.tile_size;
 
+    const std::vector<uint32_t> passes = pass_schedule(uint32_t(settings.spp));
     Progress progress("render", !options.quiet);
     RenderStats stats;
     Film film = render(
         scene, settings,
-        [&](const RenderProgress& p) { progress.update(double(p.tiles_done), double(p.tiles_total)); }, &stats);
+        [&](const RenderProgress& p) {
+          // Weigh tiles by their pass's samples: later passes are longer than the first ones.
+          double tiles_per_pass = double(p.tiles_total) / std::max(p.num_passes, 1);
+          double in_pass = double(p.tiles_done) - double(p.pass) * tiles_per_pass;
+          double done = double(p.samples_done) + double(passes[size_t(p.pass)]) * in_pass / tiles_per_pass;
+          progress.update(done, double(settings.spp));
+        },
+        &stats);
     progress.finish();
     write_outputs(options, scene, film);
 

@@ -284,6 +284,18 @@ TEST(SceneBuilder, MeshFileIsReadOnceForSeveralShapes) {
   EXPECT_NE(m1.get(), m3.get());
 }
 
+TEST(SceneBuilder, MeshErrorsNameTheMeshFileAndTheSceneElement) {
+  TempDir dir;
+  dir.write("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 nan\nf 1 2 3\n");
+  std::string xml = std::string("<scene version=\"3.0.0\">") + kCamera + R"(
+<shape type="obj"><string name="filename" value="bad.obj"/></shape>
+</scene>)";
+  SceneDesc d = parse_scene_string(xml, (dir.path / "scene.xml").string());
+  std::string msg = error_of([&] { (void)load_scene(d, {}); });
+  EXPECT_NE(msg.find("bad.obj:3"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("scene.xml:5"), std::string::npos) << msg;
+}
+
 TEST(SceneBuilder, ResolvePathNamesTheLocation) {
   TempDir dir;
   dir.write("a.txt", "x");

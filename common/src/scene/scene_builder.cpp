@@ -96,7 +96,7 @@ class ShapeBuilder {
     if (!factory) return;  // reported by the final walk: skipped
     node.used = true;
     auto cached = geometry_.find(&node);
-    if (cached == geometry_.end()) cached = geometry_.emplace(&node, factory(node, st_.ctx)).first;
+    if (cached == geometry_.end()) cached = geometry_.emplace(&node, make_geometry(node, factory)).first;
     const ShapeGeometry& g = cached->second;
 
     Transform xf = parent_xf * node.get_transform("to_world", Transform());
@@ -126,6 +126,20 @@ class ShapeBuilder {
     if (file && file->type == PropType::String) shape->name += " (" + file->s + ")";
     attach_emitter(node, *shape, in_group);
     st_.scene.shapes.push_back(std::move(shape));
+  }
+
+  // A mesh file's error names the mesh file and line; say which scene element asked for it too.
+  ShapeGeometry make_geometry(const SceneNode& node, ShapeFactory factory) {
+    try {
+      return factory(node, st_.ctx);
+    } catch (const UnsupportedError&) {
+      throw;
+    } catch (const SceneError& e) {
+      if (e.loc().file == node.loc.file) throw;
+      if (e.loc().file.empty()) throw SceneError(node.loc, node.describe() + ": " + e.what());
+      throw SceneError(e.loc(), std::string(e.what()).substr(e.loc().str().size() + 2) + " (loading " +
+                                    node.describe() + " at " + node.loc.str() + ")");
+    }
   }
 
  private:
