@@ -55,6 +55,12 @@ int main_entry(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   br->add_option("--threads", rays.threads, "Threads (default: all cores)")->check(CLI::NonNegativeNumber);
 
+  CompareOptions compare;
+  auto* cmp = app.add_subcommand("compare", "Error of an image against a reference (relMSE, means, z-scores)");
+  cmp->add_option("image", compare.image, "Rendered image (.exr/.pfm/.hdr)")->required()->check(CLI::ExistingFile);
+  cmp->add_option("reference", compare.reference, "Reference image")->required()->check(CLI::ExistingFile);
+  cmp->add_option("--variance", compare.variance, "Per-pixel variance of the reference")->check(CLI::ExistingFile);
+
   CLI11_PARSE(app, argc, argv);
 
   if (r->parsed()) {
@@ -66,6 +72,7 @@ int main_entry(int argc, char** argv) {
     return run_render(render);
   }
   if (br->parsed()) return run_bench_rays(rays);
+  if (cmp->parsed()) return run_compare(compare);
   return 2;
 }
 

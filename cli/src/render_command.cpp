@@ -132,7 +132,7 @@ int run_render(const RenderOptions& options) {
     std::fprintf(stderr, "\n");
     return 0;
   } catch (const UnsupportedError& e) {
-    std::cerr << "error: " << e.what() << "\n(--allow-unsupported renders with the listed fallbacks)\n";
+    std::cerr << "error: " << e.what() << "\n";
     return 1;
   } catch (const SceneError& e) {
     std::cerr << "error: " << e.what() << "\n";

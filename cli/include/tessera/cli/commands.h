@@ -24,10 +24,15 @@ struct RenderOptions {
   bool quiet = false;
 };
 
+struct CompareOptions {
+  std::string image, reference, variance;  // variance: the reference's per-pixel variance (optional)
+};
+
 /// Each returns the process exit code and prints its own messages.
 int run_render(const RenderOptions& options);
 /// `geometry` may also be a single scene .xml: its accelerator is used.
 int run_bench_rays(const BenchRaysOptions& options);
+int run_compare(const CompareOptions& options);
 
 /// Parses argv and runs the chosen subcommand.
 int main_entry(int argc, char** argv);
