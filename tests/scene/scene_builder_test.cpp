@@ -16,6 +16,9 @@ namespace tessera {
 namespace {
 
 namespace fs = std::filesystem;
+using test::TempDir;
+
+using test::scene_error_of;
 
 SceneDesc desc_of(const std::string& body, const std::string& version = "3.0.0",
                   const std::string& path = "mem/scene.xml") {
@@ -24,17 +27,6 @@ SceneDesc desc_of(const std::string& body, const std::string& version = "3.0.0",
 
 LoadResult load(const std::string& body, LoadOptions opt = {}, const std::string& version = "3.0.0") {
   return load_scene(desc_of(body, version), opt);
-}
-
-template <typename F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const SceneError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected a SceneError";
-  return "";
 }
 
 const TriangleMeshShape& mesh_shape(const Scene& s, size_t i) {
@@ -53,24 +45,6 @@ float measured_fov_x(const Camera& cam, int height) {
   Ray r = cam.generate_ray(Vec2(0.f, 0.5f * float(height)), Vec2(0.5f, 0.5f));
   return 2.f * std::atan2(std::abs(r.d.x), r.d.z) * 180.f / kPi;
 }
-
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    static int counter = 0;
-    path = fs::temp_directory_path() /
-           ("tessera_builder_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  std::string write(const std::string& name, const std::string& text) const {
-    std::ofstream(path / name) << text;
-    return (path / name).string();
-  }
-};
 
 const char* kCamera = R"(<sensor type="perspective">
   <float name="fov" value="40"/>
@@ -121,7 +95,7 @@ TEST(SceneBuilder, OverridesFromOptions) {
   EXPECT_EQ(r.scene->integrator.type, IntegratorType::Direct);
   EXPECT_TRUE(r.unsupported.empty());  // the replaced integrator's max_depth is not an error
   opt.integrator = "bdpt";
-  EXPECT_NE(error_of([&] { load(body, opt); }).find("bdpt"), std::string::npos);
+  EXPECT_NE(scene_error_of([&] { load(body, opt); }).find("bdpt"), std::string::npos);
 }
 
 TEST(SceneBuilder, DefaultIntegratorDependsOnVersion) {
@@ -188,7 +162,7 @@ TEST(SceneBuilder, FieldOfViewAxes) {
                         "<integer name=\"height\" value=\"16\"/></film></sensor><shape type=\"sphere\"/>");
     EXPECT_NEAR(measured_fov_x(*r.scene->camera, 16), c.expected_x, 1e-3f) << c.params;
   }
-  EXPECT_NE(error_of([] { load("<sensor type=\"perspective\"><float name=\"fov\" value=\"180\"/></sensor>"); })
+  EXPECT_NE(scene_error_of([] { load("<sensor type=\"perspective\"><float name=\"fov\" value=\"180\"/></sensor>"); })
                 .find("mem/scene.xml:2"),
             std::string::npos);
 }
@@ -291,7 +265,7 @@ TEST(SceneBuilder, MeshErrorsNameTheMeshFileAndTheSceneElement) {
 <shape type="obj"><string name="filename" value="bad.obj"/></shape>
 </scene>)";
   SceneDesc d = parse_scene_string(xml, (dir.path / "scene.xml").string());
-  std::string msg = error_of([&] { (void)load_scene(d, {}); });
+  std::string msg = scene_error_of([&] { (void)load_scene(d, {}); });
   EXPECT_NE(msg.find("bad.obj:3"), std::string::npos) << msg;
   EXPECT_NE(msg.find("scene.xml:5"), std::string::npos) << msg;
 }
@@ -303,7 +277,7 @@ TEST(SceneBuilder, ResolvePathNamesTheLocation) {
   Scene scene;
   LoadContext ctx(d, {}, scene);
   EXPECT_EQ(ctx.resolve_path("a.txt", {"s.xml", 3}), (dir.path / "a.txt").string());
-  std::string msg = error_of([&] { ctx.resolve_path("missing.obj", {"s.xml", 7}); });
+  std::string msg = scene_error_of([&] { ctx.resolve_path("missing.obj", {"s.xml", 7}); });
   EXPECT_NE(msg.find("s.xml:7"), std::string::npos) << msg;
   EXPECT_NE(msg.find("missing.obj"), std::string::npos) << msg;
 }
@@ -314,7 +288,7 @@ TEST(SceneBuilder, EmittersAtTopLevelAndOnShapes) {
 <shape type="rectangle"><emitter type="area"><rgb name="radiance" value="3"/></emitter></shape>)");
   EXPECT_EQ(r.scene->lights.size(), 2u);
   EXPECT_NE(r.scene->shapes[0]->light, nullptr);
-  EXPECT_NE(error_of([] { load("<emitter type=\"area\"/>"); }).find("mem/scene.xml:2"), std::string::npos);
+  EXPECT_NE(scene_error_of([] { load("<emitter type=\"area\"/>"); }).find("mem/scene.xml:2"), std::string::npos);
 }
 
 const char* kUnsupportedScene = R"(<bsdf type="made_up_bsdf" id="mystery">
@@ -437,17 +411,17 @@ TEST(SceneBuilder, UnreferencedDefinitionsAreNotReported) {
 }
 
 TEST(SceneBuilder, BuilderErrorsNameFileAndLine) {
-  std::string msg = error_of([] {
+  std::string msg = scene_error_of([] {
     load("<sensor type=\"perspective\"><float name=\"fov\" value=\"30\"/>\n"
          "<film type=\"hdrfilm\">\n<integer name=\"width\" value=\"0\"/></film></sensor>");
   });
   EXPECT_NE(msg.find("mem/scene.xml:4"), std::string::npos) << msg;
-  msg = error_of([] { load("<shape type=\"sphere\">\n<float name=\"radius\" value=\"-1\"/></shape>"); });
+  msg = scene_error_of([] { load("<shape type=\"sphere\">\n<float name=\"radius\" value=\"-1\"/></shape>"); });
   EXPECT_NE(msg.find("mem/scene.xml:3"), std::string::npos) << msg;
-  msg = error_of([] { load("<shape type=\"obj\">\n<string name=\"filename\" value=\"nothere.obj\"/></shape>"); });
+  msg = scene_error_of([] { load("<shape type=\"obj\">\n<string name=\"filename\" value=\"nothere.obj\"/></shape>"); });
   EXPECT_NE(msg.find("mem/scene.xml:3"), std::string::npos) << msg;
   EXPECT_NE(msg.find("nothere.obj"), std::string::npos) << msg;
-  msg = error_of([] { load("<shape type=\"sphere\"><bsdf type=\"diffuse\"/>\n<bsdf type=\"diffuse\"/></shape>"); });
+  msg = scene_error_of([] { load("<shape type=\"sphere\"><bsdf type=\"diffuse\"/>\n<bsdf type=\"diffuse\"/></shape>"); });
   EXPECT_NE(msg.find("mem/scene.xml:3"), std::string::npos) << msg;
 }
 

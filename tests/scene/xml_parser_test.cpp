@@ -15,21 +15,12 @@ namespace tessera {
 namespace {
 
 namespace fs = std::filesystem;
+using test::TempDir;
+
+using test::scene_error_of;
 
 SceneDesc parse(const std::string& body, const std::string& version = "3.0.0", const ParseOptions& opt = {}) {
   return parse_scene_string("<scene version=\"" + version + "\">\n" + body + "\n</scene>\n", "test.xml", opt);
-}
-
-/// The message of the SceneError `f` throws (fails the test when it does not throw).
-template <typename F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const SceneError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected a SceneError";
-  return "";
 }
 
 const Property& prop(const SceneNode& n, const std::string& name) {
@@ -43,27 +34,6 @@ void expect_matrix_near(const Matrix4& a, const Matrix4& b, double tol = 1e-6) {
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j) EXPECT_NEAR(a.m[i][j], b.m[i][j], tol) << "entry " << i << "," << j;
 }
-
-/// A fresh directory under the system temp dir, removed at scope exit.
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    static int counter = 0;
-    path = fs::temp_directory_path() /
-           ("tessera_xml_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  std::string write(const std::string& name, const std::string& text) const {
-    fs::path p = path / name;
-    fs::create_directories(p.parent_path());
-    std::ofstream(p) << text;
-    return p.string();
-  }
-};
 
 TEST(XmlParser, ScalarProperties) {
   auto d = parse(R"(<integrator type="path">
@@ -113,12 +83,12 @@ TEST(XmlParser, WrongTypeNamesPropertyNodeFileAndLine) {
   <string name="alpha" value="rough"/>
 </bsdf>)");
   const SceneNode& n = *d.root->children[0];
-  std::string msg = error_of([&] { n.get_float("alpha", 0.f); });
+  std::string msg = scene_error_of([&] { n.get_float("alpha", 0.f); });
   EXPECT_NE(msg.find("test.xml:4"), std::string::npos) << msg;
   EXPECT_NE(msg.find("'alpha'"), std::string::npos) << msg;
   EXPECT_NE(msg.find("bsdf 'diffuse'"), std::string::npos) << msg;
-  EXPECT_NE(error_of([&] { n.get_color("alpha", Rgb()); }).find("test.xml:4"), std::string::npos);
-  EXPECT_NE(error_of([&] { n.get_bool("alpha", false); }).find("must be a boolean"), std::string::npos);
+  EXPECT_NE(scene_error_of([&] { n.get_color("alpha", Rgb()); }).find("test.xml:4"), std::string::npos);
+  EXPECT_NE(scene_error_of([&] { n.get_bool("alpha", false); }).find("must be a boolean"), std::string::npos);
 }
 
 TEST(XmlParser, RgbForms) {
@@ -329,11 +299,11 @@ TEST(XmlParser, DefaultsSubstitutionAndDefines) {
 }
 
 TEST(XmlParser, UndefinedParameterNamesFileAndLine) {
-  std::string msg = error_of([] { parse("<sampler type=\"sobol\">\n<integer name=\"n\" value=\"$nope\"/></sampler>"); });
+  std::string msg = scene_error_of([] { parse("<sampler type=\"sobol\">\n<integer name=\"n\" value=\"$nope\"/></sampler>"); });
   EXPECT_NE(msg.find("test.xml:3"), std::string::npos) << msg;
   EXPECT_NE(msg.find("$nope"), std::string::npos) << msg;
   // A default declared after its use does not count (Mitsuba reads in order).
-  msg = error_of([] { parse("<sampler type=\"$t\"/>\n<default name=\"t\" value=\"sobol\"/>"); });
+  msg = scene_error_of([] { parse("<sampler type=\"$t\"/>\n<default name=\"t\" value=\"sobol\"/>"); });
   EXPECT_NE(msg.find("test.xml:2"), std::string::npos) << msg;
 }
 
@@ -355,13 +325,13 @@ TEST(XmlParser, RefsAliasesAndIds) {
   EXPECT_EQ(c[2]->child_names[0], "");
   EXPECT_EQ(c[2]->children_with_tag("bsdf").size(), 1u);
 
-  std::string msg = error_of([] { parse("<shape type=\"sphere\">\n<ref id=\"later\"/></shape>\n<bsdf type=\"diffuse\" id=\"later\"/>"); });
+  std::string msg = scene_error_of([] { parse("<shape type=\"sphere\">\n<ref id=\"later\"/></shape>\n<bsdf type=\"diffuse\" id=\"later\"/>"); });
   EXPECT_NE(msg.find("test.xml:3"), std::string::npos) << msg;
   EXPECT_NE(msg.find("'later'"), std::string::npos) << msg;
-  msg = error_of([] { parse("<bsdf type=\"diffuse\" id=\"a\"/>\n<bsdf type=\"diffuse\" id=\"a\"/>"); });
+  msg = scene_error_of([] { parse("<bsdf type=\"diffuse\" id=\"a\"/>\n<bsdf type=\"diffuse\" id=\"a\"/>"); });
   EXPECT_NE(msg.find("test.xml:3"), std::string::npos) << msg;
   EXPECT_NE(msg.find("duplicate id 'a'"), std::string::npos) << msg;
-  msg = error_of([] { parse("<bsdf type=\"twosided\" id=\"self\"><ref id=\"self\"/></bsdf>"); });
+  msg = scene_error_of([] { parse("<bsdf type=\"twosided\" id=\"self\"><ref id=\"self\"/></bsdf>"); });
   EXPECT_NE(msg.find("unknown id 'self'"), std::string::npos) << msg;
 }
 
@@ -415,15 +385,15 @@ TEST(XmlParser, IncludeErrors) {
   dir.write("a.xml", "<scene version=\"3.0.0\">\n<include filename=\"b.xml\"/>\n</scene>");
   dir.write("b.xml", "<scene version=\"3.0.0\">\n\n<include filename=\"a.xml\"/>\n</scene>");
   dir.write("bad.xml", "<scene version=\"3.0.0\">\n<bsdf type=\"diffuse\">\n<float name=\"x\" value=\"1.0x\"/>\n</bsdf></scene>");
-  std::string msg = error_of([&] { parse_scene_file((dir.path / "a.xml").string()); });
+  std::string msg = scene_error_of([&] { parse_scene_file((dir.path / "a.xml").string()); });
   EXPECT_NE(msg.find("b.xml:3"), std::string::npos) << msg;
   EXPECT_NE(msg.find("cycle"), std::string::npos) << msg;
-  msg = error_of([&] {
+  msg = scene_error_of([&] {
     parse_scene_string("<scene version=\"3.0.0\">\n<include filename=\"bad.xml\"/>\n</scene>",
                        (dir.path / "main.xml").string());
   });
   EXPECT_NE(msg.find("bad.xml:3"), std::string::npos) << msg;
-  msg = error_of([&] {
+  msg = scene_error_of([&] {
     parse_scene_string("<scene version=\"3.0.0\">\n<include filename=\"missing.xml\"/>\n</scene>",
                        (dir.path / "main.xml").string());
   });
@@ -464,25 +434,25 @@ TEST(XmlParser, ErrorsNameFileAndLine) {
       {"\n<ref id=\"x\"/>", 3, "<ref>"},
   };
   for (const auto& c : cases) {
-    std::string msg = error_of([&] { parse(c.body); });
+    std::string msg = scene_error_of([&] { parse(c.body); });
     EXPECT_NE(msg.find("test.xml:" + std::to_string(c.line) + ":"), std::string::npos) << c.body << "\n-> " << msg;
     EXPECT_NE(msg.find(c.words), std::string::npos) << c.body << "\n-> " << msg;
   }
 }
 
 TEST(XmlParser, MalformedXmlNamesLine) {
-  std::string msg = error_of([] {
+  std::string msg = scene_error_of([] {
     parse_scene_string("<scene version=\"3.0.0\">\n<bsdf type=\"diffuse\">\n\n</scene>\n", "dir/broken.xml");
   });
   EXPECT_NE(msg.find("dir/broken.xml:4"), std::string::npos) << msg;
   EXPECT_NE(msg.find("malformed XML"), std::string::npos) << msg;
-  msg = error_of([] { parse_scene_string("<scene>\n</scene>", "x.xml"); });
+  msg = scene_error_of([] { parse_scene_string("<scene>\n</scene>", "x.xml"); });
   EXPECT_NE(msg.find("version"), std::string::npos) << msg;
-  msg = error_of([] { parse_scene_string("<scene version=\"3.0.0\"/>\n<scene version=\"3.0.0\"/>", "x.xml"); });
+  msg = scene_error_of([] { parse_scene_string("<scene version=\"3.0.0\"/>\n<scene version=\"3.0.0\"/>", "x.xml"); });
   EXPECT_NE(msg.find("x.xml:2"), std::string::npos) << msg;
-  msg = error_of([] { parse_scene_string("", "empty.xml"); });
+  msg = scene_error_of([] { parse_scene_string("", "empty.xml"); });
   EXPECT_NE(msg.find("empty.xml"), std::string::npos) << msg;
-  msg = error_of([] { parse_scene_file("/nonexistent/dir/scene.xml"); });
+  msg = scene_error_of([] { parse_scene_file("/nonexistent/dir/scene.xml"); });
   EXPECT_NE(msg.find("/nonexistent/dir/scene.xml"), std::string::npos) << msg;
 }
 
