@@ -54,6 +54,8 @@ int main_entry(int argc, char** argv) {
   br->add_option("--compare", rays.compare, "Reference hit file to check agreement against")
       ->check(CLI::ExistingFile);
   br->add_option("--threads", rays.threads, "Threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  br->add_option("--repeat", rays.repeat, "Trace each set this often and report the median (default 1)")
+      ->check(CLI::Range(1, 100));
 
   CompareOptions compare;
   auto* cmp = app.add_subcommand("compare", "Error of an image against a reference (relMSE, means, z-scores)");
