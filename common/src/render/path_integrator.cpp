@@ -18,7 +18,7 @@ class PathIntegrator final : public Integrator {
          RenderCounters& counters) const override {
     if (s_.max_depth == 0) return {};
     Rgb L, throughput(1.f);
-    const float eta = 1.f;  // relative IOR along the path; no refraction among current BSDFs
+    float eta = 1.f;  // product of the relative IORs crossed by refraction (BsdfSample::eta)
     Ray ray = camera_ray;
     int depth = 0;  // scattering events so far
     float prev_bsdf_pdf = 0.f;
@@ -75,6 +75,7 @@ class PathIntegrator final : public Integrator {
       throughput *= bs.weight;
       prev_bsdf_pdf = bs.pdf;
       prev_delta = bs.delta;
+      eta *= bs.eta;
       prev_p = si.p;
       ++depth;
 

@@ -10,7 +10,15 @@ namespace tessera {
 // -- bsdfs --
 std::shared_ptr<Bsdf> make_diffuse(const SceneNode&, LoadContext&);
 std::shared_ptr<Bsdf> make_twosided(const SceneNode&, LoadContext&);
+std::shared_ptr<Bsdf> make_conductor(const SceneNode&, LoadContext&);
+std::shared_ptr<Bsdf> make_roughconductor(const SceneNode&, LoadContext&);
+std::shared_ptr<Bsdf> make_dielectric(const SceneNode&, LoadContext&);
+std::shared_ptr<Bsdf> make_thindielectric(const SceneNode&, LoadContext&);
+std::shared_ptr<Bsdf> make_plastic(const SceneNode&, LoadContext&);
 // -- textures --
+std::shared_ptr<Texture> make_bitmap(const SceneNode&, LoadContext&);
+std::shared_ptr<Texture> make_checkerboard(const SceneNode&, LoadContext&);
+std::shared_ptr<Texture> make_scale(const SceneNode&, LoadContext&);
 // -- lights --
 std::unique_ptr<Light> make_point(const SceneNode&, LoadContext&);
 std::unique_ptr<Light> make_envmap(const SceneNode&, LoadContext&);
@@ -42,9 +50,17 @@ F find(const Entry<F> (&table)[N], const std::string& type) {
 const Entry<BsdfFactory> kBsdfs[] = {
     {"diffuse", make_diffuse},
     {"twosided", make_twosided},
+    {"conductor", make_conductor},
+    {"roughconductor", make_roughconductor},
+    {"dielectric", make_dielectric},
+    {"thindielectric", make_thindielectric},
+    {"plastic", make_plastic},
     {"", nullptr},
 };
 const Entry<TextureFactory> kTextures[] = {
+    {"bitmap", make_bitmap},
+    {"checkerboard", make_checkerboard},
+    {"scale", make_scale},
     {"", nullptr},
 };
 const Entry<LightFactory> kLights[] = {

@@ -76,6 +76,15 @@ std::shared_ptr<const MeshData> LoadContext::cached_mesh(const std::string& key,
   return mesh;
 }
 
+std::shared_ptr<const Image> LoadContext::cached_image(const std::string& key,
+                                                      const std::function<Image()>& load) {
+  auto it = images_.find(key);
+  if (it != images_.end()) return it->second;
+  auto image = std::make_shared<const Image>(load());
+  images_.emplace(key, image);
+  return image;
+}
+
 const Bsdf* LoadContext::bsdf(const std::shared_ptr<SceneNode>& node) {
   const SceneNode* key = node.get();
   auto it = bsdfs_.find(key);

@@ -19,6 +19,10 @@ struct BsdfSample {
   float pdf = 0.f;   // solid angle; for a delta lobe, the discrete probability of choosing it
   Rgb weight;        // eval * |cos| / pdf (for delta lobes: the lobe's throughput / probability)
   bool delta = false;
+  /// Relative IOR crossed by a refraction (n on the wi side over n on the wo side, Mitsuba 0.6's
+  /// bRec.eta); 1 for reflection. The path tracer multiplies these along the path to undo the
+  /// 1/eta^2 radiance scaling in Russian roulette.
+  float eta = 1.f;
 };
 
 class Bsdf {

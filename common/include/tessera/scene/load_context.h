@@ -8,6 +8,7 @@
 #pragma once
 
 #include "tessera/core/rgb.h"
+#include "tessera/image/image.h"
 #include "tessera/render/scene.h"
 #include "tessera/render/shape.h"
 #include "tessera/render/texture.h"
@@ -55,6 +56,12 @@ class LoadContext {
   std::shared_ptr<const MeshData> cached_mesh(const std::string& key,
                                               const std::function<MeshData()>& load);
 
+  /// Decodes an image once per key (resolved path plus whatever changes the decoded values, e.g.
+  /// gamma) and shares it: a file used by several textures is read once per scene.
+  std::shared_ptr<const Image> cached_image(const std::string& key, const std::function<Image()>& load);
+  /// Number of distinct images decoded so far.
+  size_t num_cached_images() const { return images_.size(); }
+
   /// Builds (once per node) the BSDF a shape refers to; null node -> the default diffuse BSDF.
   /// texture() and bsdf() mark the nested node consumed; a factory that uses a nested node any
   /// other way must set `node->used = true`, or the node is reported as unused.
@@ -80,6 +87,7 @@ class LoadContext {
   std::map<const SceneNode*, std::shared_ptr<Texture>> textures_;
   std::map<const SceneNode*, const Bsdf*> bsdfs_;
   std::map<std::string, std::shared_ptr<const MeshData>> meshes_;
+  std::map<std::string, std::shared_ptr<const Image>> images_;
 };
 
 using BsdfFactory = std::shared_ptr<Bsdf> (*)(const SceneNode&, LoadContext&);

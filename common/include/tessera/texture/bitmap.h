@@ -1,0 +1,78 @@
+// Image textures (Mitsuba's `bitmap`) and the uv mapping shared by 2D textures.
+//
+// Conventions follow Mitsuba 0.6's MIPMap: texel (x, y) with row 0 the file's top row covers
+// uv in [x/w, (x+1)/w] x [y/h, (y+1)/h], i.e. v = 0 is the top of the image (mesh loaders already
+// flip OBJ texture coordinates as Mitsuba does). Bilinear lookups sample at u*w - 0.5, v*h - 0.5.
+#pragma once
+
+#include "tessera/core/transform.h"
+#include "tessera/image/image.h"
+#include "tessera/render/texture.h"
+
+#include <memory>
+#include <optional>
+#include <string>
+
+namespace tessera {
+
+/// Mitsuba's boundary conditions for lookups outside [0,1]^2. Zero/One return that constant in
+/// every channel, alpha included.
+enum class WrapMode { Repeat, Mirror, Clamp, Zero, One };
+/// Mitsuba 0.6 names: repeat, mirror, clamp, zero|black, one|white. Empty when unknown.
+std::optional<WrapMode> parse_wrap_mode(const std::string& name);
+
+enum class TextureFilter { Bilinear, Nearest };
+
+/// The affine part of a `to_uv` transform (uv' = A uv + t), applied before a lookup.
+class UvMapping {
+ public:
+  UvMapping() = default;
+  explicit UvMapping(const Transform& to_uv);
+  Vec2 apply(Vec2 uv) const {
+    return {m_[0] * uv.x + m_[1] * uv.y + m_[2], m_[3] * uv.x + m_[4] * uv.y + m_[5]};
+  }
+
+ private:
+  float m_[6] = {1, 0, 0, 0, 1, 0};
+};
+
+class BitmapTexture final : public Texture {
+ public:
+  /// `image` holds linear values (decoding already done), 1, 3 or 4 channels.
+  BitmapTexture(std::shared_ptr<const Image> image, WrapMode wrap_u, WrapMode wrap_v,
+                TextureFilter filter = TextureFilter::Bilinear, UvMapping to_uv = {});
+
+  Rgb eval(const SurfaceInteraction& si) const override { return lookup(to_uv_.apply(si.uv)); }
+  float eval_1(const SurfaceInteraction& si) const override;
+  /// Alpha channel at the surface point (1 for images without alpha); for masks.
+  float alpha(const SurfaceInteraction& si) const { return lookup_channel(to_uv_.apply(si.uv), 3); }
+  Rgb mean() const override { return mean_; }
+
+  /// Colour at texture coordinates already mapped by to_uv.
+  Rgb lookup(Vec2 uv) const;
+  /// One channel (0..3; 3 = alpha, 1 when absent) at mapped texture coordinates.
+  float lookup_channel(Vec2 uv, int channel) const;
+
+  const std::shared_ptr<const Image>& image() const { return image_; }
+  WrapMode wrap_u() const { return wrap_u_; }
+  WrapMode wrap_v() const { return wrap_v_; }
+
+ private:
+  /// Resolves a texel index against the wrap mode; -1 = outside (Zero/One).
+  static int wrap(int i, int n, WrapMode mode);
+  template <typename Fetch>
+  auto filtered(Vec2 uv, Fetch fetch) const;
+
+  std::shared_ptr<const Image> image_;
+  WrapMode wrap_u_, wrap_v_;
+  TextureFilter filter_;
+  UvMapping to_uv_;
+  Rgb mean_;
+};
+
+/// How Mitsuba decodes a bitmap's stored values into linear ones: `gamma` 0 = automatic (sRGB for
+/// 8-bit files, linear for float files, unless `raw`), -1 = sRGB curve, g > 0 = v^g. Alpha is
+/// never decoded.
+Image decode_bitmap_values(const Image& stored, float gamma, bool raw);
+
+}  // namespace tessera

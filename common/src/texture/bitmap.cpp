@@ -1,0 +1,196 @@
+// Mitsuba's `bitmap` texture: an image file looked up at the surface's uv, decoded to linear values
+// once per scene (LoadContext::cached_image) and filtered bilinearly (or nearest) as Mitsuba 0.6's
+// MIPMap does at its finest level.
+#include "tessera/texture/bitmap.h"
+
+#include "tessera/scene/load_context.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+
+namespace tessera {
+
+std::optional<WrapMode> parse_wrap_mode(const std::string& name) {
+  if (name == "repeat") return WrapMode::Repeat;
+  if (name == "mirror") return WrapMode::Mirror;
+  if (name == "clamp") return WrapMode::Clamp;
+  if (name == "zero" || name == "black") return WrapMode::Zero;
+  if (name == "one" || name == "white") return WrapMode::One;
+  return std::nullopt;
+}
+
+UvMapping::UvMapping(const Transform& to_uv) {
+  // uv lives in the xy plane of Mitsuba's 4x4 <transform>; z is ignored.
+  const auto& m = to_uv.matrix().m;
+  m_[0] = float(m[0][0]), m_[1] = float(m[0][1]), m_[2] = float(m[0][3]);
+  m_[3] = float(m[1][0]), m_[4] = float(m[1][1]), m_[5] = float(m[1][3]);
+}
+
+BitmapTexture::BitmapTexture(std::shared_ptr<const Image> image, WrapMode wrap_u, WrapMode wrap_v,
+                             TextureFilter filter, UvMapping to_uv)
+    : image_(std::move(image)), wrap_u_(wrap_u), wrap_v_(wrap_v), filter_(filter), to_uv_(to_uv) {
+  TESSERA_CHECK(image_ && !image_->empty());
+  // Summed in double: large textures would otherwise lose the small texels.
+  double sum[3] = {0, 0, 0};
+  for (int y = 0; y < image_->height(); ++y)
+    for (int x = 0; x < image_->width(); ++x) {
+      Rgb c = image_->rgb(x, y);
+      for (int i = 0; i < 3; ++i) sum[i] += double(c[i]);
+    }
+  double n = double(image_->num_pixels());
+  mean_ = Rgb(float(sum[0] / n), float(sum[1] / n), float(sum[2] / n));
+}
+
+int BitmapTexture::wrap(int i, int n, WrapMode mode) {
+  switch (mode) {
+    case WrapMode::Repeat: {
+      int r = i % n;
+      return r < 0 ? r + n : r;
+    }
+    case WrapMode::Mirror: {
+      int r = i % (2 * n);
+      if (r < 0) r += 2 * n;
+      return r >= n ? 2 * n - r - 1 : r;
+    }
+    case WrapMode::Clamp: return std::clamp(i, 0, n - 1);
+    case WrapMode::Zero: return i >= 0 && i < n ? i : -1;
+    case WrapMode::One: return i >= 0 && i < n ? i : -2;
+  }
+  return -1;
+}
+
+template <typename Fetch>
+auto BitmapTexture::filtered(Vec2 uv, Fetch fetch) const {
+  using T = decltype(fetch(0, 0));
+  // Texel index -> value with Mitsuba's boundary handling (u decided first, as Mitsuba does).
+  auto texel = [&](int x, int y) -> T {
+    int xi = wrap(x, image_->width(), wrap_u_);
+    if (xi < 0) return T(xi == -1 ? 0.f : 1.f);
+    int yi = wrap(y, image_->height(), wrap_v_);
+    if (yi < 0) return T(yi == -1 ? 0.f : 1.f);
+    return fetch(xi, yi);
+  };
+  float u = uv.x * float(image_->width()), v = uv.y * float(image_->height());
+  // NaN/huge coordinates would overflow the integer conversion; Mitsuba returns 0 for NaN.
+  if (!(std::abs(u) < 1e9f) || !(std::abs(v) < 1e9f)) return T(0.f);
+  if (filter_ == TextureFilter::Nearest) return texel(int(std::floor(u)), int(std::floor(v)));
+  u -= 0.5f;
+  v -= 0.5f;
+  float fx = std::floor(u), fy = std::floor(v);
+  int x = int(fx), y = int(fy);
+  float dx = u - fx, dy = v - fy;
+  return texel(x, y) * ((1.f - dx) * (1.f - dy)) + texel(x, y + 1) * ((1.f - dx) * dy) +
+         texel(x + 1, y) * (dx * (1.f - dy)) + texel(x + 1, y + 1) * (dx * dy);
+}
+
+Rgb BitmapTexture::lookup(Vec2 uv) const {
+  return filtered(uv, [this](int x, int y) { return image_->rgb(x, y); });
+}
+
+float BitmapTexture::lookup_channel(Vec2 uv, int channel) const {
+  TESSERA_DCHECK(channel >= 0 && channel < 4);
+  const Image& im = *image_;
+  if (channel == 3 && !im.has_alpha()) return 1.f;
+  int c = im.channels() == 1 && channel < 3 ? 0 : channel;
+  return filtered(uv, [&im, c](int x, int y) { return im.at(x, y, c); });
+}
+
+float BitmapTexture::eval_1(const SurfaceInteraction& si) const {
+  Vec2 uv = to_uv_.apply(si.uv);
+  if (image_->channels() == 1) return lookup_channel(uv, 0);
+  return lookup(uv).average();
+}
+
+Image decode_bitmap_values(const Image& stored, float gamma, bool raw) {
+  if (gamma == 0.f) {
+    if (!raw) return stored.linearized();
+    Image out = stored;
+    out.set_srgb_encoded(false);
+    return out;
+  }
+  Image out = stored;
+  out.set_srgb_encoded(false);
+  int colour_channels = out.channels() == 4 ? 3 : out.channels();
+  float* px = out.data();
+  for (size_t i = 0; i < out.num_pixels(); ++i)
+    for (int c = 0; c < colour_channels; ++c) {
+      float& v = px[i * size_t(out.channels()) + size_t(c)];
+      if (gamma < 0.f)
+        v = srgb_to_linear(v);
+      else
+        v = std::copysign(std::pow(std::abs(v), gamma), v);
+    }
+  return out;
+}
+
+namespace {
+
+WrapMode read_wrap_mode(const SceneNode& node, const std::string& name, const std::string& def) {
+  std::string value = node.get_string(name, def);
+  std::transform(value.begin(), value.end(), value.begin(), [](unsigned char ch) { return char(std::tolower(ch)); });
+  if (auto mode = parse_wrap_mode(value)) return *mode;
+  const Property* p = node.find(name);
+  throw SceneError(p ? p->loc : node.loc, node.describe() + ": unknown " + name + " '" + value +
+                                              "' (repeat, mirror, clamp, zero/black, one/white)");
+}
+
+TextureFilter read_filter(const SceneNode& node) {
+  const Property* p = node.find("filter_type");
+  if (!p || p->type != PropType::String) {
+    node.get_string("filter_type", "");  // a wrongly typed value is reported by the getter
+    return TextureFilter::Bilinear;
+  }
+  std::string value = p->s;
+  std::transform(value.begin(), value.end(), value.begin(), [](unsigned char ch) { return char(std::tolower(ch)); });
+  if (value == "nearest") {
+    p->used = true;
+    return TextureFilter::Nearest;
+  }
+  if (value == "bilinear") {
+    p->used = true;
+    return TextureFilter::Bilinear;
+  }
+  // Left unread on purpose: the loader notes ewa/trilinear once per scene as image-neutral
+  // (evaluated bilinearly, without MIP maps), and reports any other value as unsupported.
+  if (value == "ewa" || value == "trilinear") return TextureFilter::Bilinear;
+  throw SceneError(p->loc, node.describe() + ": unknown filter_type '" + p->s +
+                               "' (ewa, trilinear, bilinear, nearest)");
+}
+
+}  // namespace
+
+std::shared_ptr<Texture> make_bitmap(const SceneNode& node, LoadContext& ctx) {
+  const Property* file = node.find("filename");
+  if (!file) throw SceneError(node.loc, node.describe() + " needs a 'filename'");
+  std::string name = node.get_string("filename", "");
+  std::string path = ctx.resolve_path(name, file->loc);
+
+  float gamma = node.get_float("gamma", 0.f);
+  if (!(gamma == 0.f || gamma == -1.f || (gamma > 0.f && std::isfinite(gamma))))
+    throw SceneError(node.find("gamma")->loc,
+                     node.describe() + ": gamma must be -1 (sRGB) or positive, got " + std::to_string(gamma));
+  bool raw = node.get_bool("raw", false);
+
+  // wrap_mode first, so a bad value is reported under its own name and line.
+  WrapMode wrap = read_wrap_mode(node, "wrap_mode", "repeat");
+  WrapMode wrap_u = node.has("wrap_mode_u") ? read_wrap_mode(node, "wrap_mode_u", "") : wrap;
+  WrapMode wrap_v = node.has("wrap_mode_v") ? read_wrap_mode(node, "wrap_mode_v", "") : wrap;
+  TextureFilter filter = read_filter(node);
+  UvMapping to_uv(node.get_transform("to_uv", Transform()));
+
+  std::string key = path + "|gamma=" + std::to_string(gamma) + "|raw=" + (raw ? "1" : "0");
+  std::shared_ptr<const Image> image = ctx.cached_image(key, [&] {
+    try {
+      Image stored = read_image(path);
+      if (stored.empty()) throw SceneError("image has no pixels");
+      return decode_bitmap_values(stored, gamma, raw);
+    } catch (const SceneError& e) {
+      // The reader names the file; the scene location says which texture wanted it.
+      throw SceneError(file->loc, node.describe() + ": " + e.what());
+    }
+  });
+  return std::make_shared<BitmapTexture>(std::move(image), wrap_u, wrap_v, filter, to_uv);
+}
+
+}  // namespace tessera
