@@ -9,12 +9,16 @@ namespace tessera {
 // Factories, one per plugin file (declared here rather than in headers: nothing else calls them).
 // -- bsdfs --
 std::shared_ptr<Bsdf> make_diffuse(const SceneNode&, LoadContext&);
+std::shared_ptr<Bsdf> make_roughdiffuse(const SceneNode&, LoadContext&);
+std::shared_ptr<Bsdf> make_phong(const SceneNode&, LoadContext&);
 std::shared_ptr<Bsdf> make_twosided(const SceneNode&, LoadContext&);
 std::shared_ptr<Bsdf> make_conductor(const SceneNode&, LoadContext&);
 std::shared_ptr<Bsdf> make_roughconductor(const SceneNode&, LoadContext&);
 std::shared_ptr<Bsdf> make_dielectric(const SceneNode&, LoadContext&);
+std::shared_ptr<Bsdf> make_roughdielectric(const SceneNode&, LoadContext&);
 std::shared_ptr<Bsdf> make_thindielectric(const SceneNode&, LoadContext&);
 std::shared_ptr<Bsdf> make_plastic(const SceneNode&, LoadContext&);
+std::shared_ptr<Bsdf> make_roughplastic(const SceneNode&, LoadContext&);
 // -- textures --
 std::shared_ptr<Texture> make_bitmap(const SceneNode&, LoadContext&);
 std::shared_ptr<Texture> make_checkerboard(const SceneNode&, LoadContext&);
@@ -49,12 +53,16 @@ F find(const Entry<F> (&table)[N], const std::string& type) {
 
 const Entry<BsdfFactory> kBsdfs[] = {
     {"diffuse", make_diffuse},
+    {"roughdiffuse", make_roughdiffuse},
+    {"phong", make_phong},
     {"twosided", make_twosided},
     {"conductor", make_conductor},
     {"roughconductor", make_roughconductor},
     {"dielectric", make_dielectric},
+    {"roughdielectric", make_roughdielectric},
     {"thindielectric", make_thindielectric},
     {"plastic", make_plastic},
+    {"roughplastic", make_roughplastic},
     {"", nullptr},
 };
 const Entry<TextureFactory> kTextures[] = {
