@@ -15,7 +15,7 @@ namespace tessera {
 namespace {
 
 using test::at_uv;
-using test::error_of;
+using test::scene_error_of;
 using test::TextureScene;
 using test::TextureTempDir;
 
@@ -99,7 +99,7 @@ TEST(BitmapTexture, MipMapFiltersAreLeftForTheNeutralNoteAndUnknownOnesFail) {
   expect_rgb_near(tex->eval(at_uv(0.25f, 0.25f)), (texel_value(0, 0) + texel_value(1, 0)) * 0.5f);
 
   TextureScene bad(bitmap_xml(path, "\n<string name=\"filterType\" value=\"cubic\"/>"), "0.6.0");
-  std::string msg = error_of([&] { bad.texture("m"); });
+  std::string msg = scene_error_of([&] { bad.texture("m"); });
   EXPECT_NE(msg.find("scene.xml:3"), std::string::npos) << msg;
   EXPECT_NE(msg.find("cubic"), std::string::npos) << msg;
 }
@@ -146,7 +146,7 @@ TEST(BitmapTexture, WrapModes) {
   }
   {
     TextureScene bad(bitmap_xml(path, "\n\n<string name=\"wrapMode\" value=\"wrap\"/>"), "0.6.0");
-    std::string msg = error_of([&] { bad.texture("m"); });
+    std::string msg = scene_error_of([&] { bad.texture("m"); });
     EXPECT_NE(msg.find("scene.xml:4"), std::string::npos) << msg;
     EXPECT_NE(msg.find("'wrap'"), std::string::npos) << msg;
   }
@@ -201,7 +201,7 @@ TEST(BitmapTexture, EightBitDecoding) {
   EXPECT_NE(srgb_to_linear(64.f / 255.f), 64.f / 255.f);  // the cases above are distinguishable
 
   TextureScene bad(bitmap_xml(path, "\n<float name=\"gamma\" value=\"-2\"/>"), "0.6.0");
-  std::string msg = error_of([&] { bad.texture("m"); });
+  std::string msg = scene_error_of([&] { bad.texture("m"); });
   EXPECT_NE(msg.find("scene.xml:3"), std::string::npos) << msg;
 }
 
@@ -287,12 +287,12 @@ TEST(BitmapTexture, SharedSceneLoadsWithoutUnsupportedBitmapItems) {
 
 TEST(BitmapTexture, ErrorsNameFileAndLine) {
   TextureScene missing(bitmap_xml("no_such_texture.png"), "0.6.0", "dir/scene.xml");
-  std::string msg = error_of([&] { missing.texture("m"); });
+  std::string msg = scene_error_of([&] { missing.texture("m"); });
   EXPECT_NE(msg.find("no_such_texture.png"), std::string::npos) << msg;
   EXPECT_NE(msg.find("dir/scene.xml:2"), std::string::npos) << msg;
 
   TextureScene no_name("<bsdf type=\"diffuse\" id=\"m\">\n<texture type=\"bitmap\" name=\"reflectance\"/></bsdf>");
-  msg = error_of([&] { no_name.texture("m"); });
+  msg = scene_error_of([&] { no_name.texture("m"); });
   EXPECT_NE(msg.find("scene.xml:3"), std::string::npos) << msg;
   EXPECT_NE(msg.find("filename"), std::string::npos) << msg;
 
@@ -300,7 +300,7 @@ TEST(BitmapTexture, ErrorsNameFileAndLine) {
   std::string garbage = dir.file("broken.png");
   { std::ofstream(garbage) << "not a png"; }
   TextureScene broken(bitmap_xml(garbage));
-  msg = error_of([&] { broken.texture("m"); });
+  msg = scene_error_of([&] { broken.texture("m"); });
   EXPECT_NE(msg.find("scene.xml:2"), std::string::npos) << msg;
   EXPECT_NE(msg.find("broken.png"), std::string::npos) << msg;
 }

@@ -9,7 +9,7 @@ namespace tessera {
 namespace {
 
 using test::at_uv;
-using test::error_of;
+using test::scene_error_of;
 using test::TextureScene;
 
 std::string in_bsdf(const std::string& texture_xml, const std::string& id = "m") {
@@ -66,7 +66,7 @@ TEST(ScaleTexture, ValueAndSpectralScale) {
 TEST(ScaleTexture, NeedsSomethingToScale) {
   TextureScene s(in_bsdf("\n<texture type=\"scale\" name=\"reflectance\"><float name=\"scale\" value=\"2\"/></texture>"),
                  "0.6.0");
-  std::string msg = error_of([&] { s.texture("m"); });
+  std::string msg = scene_error_of([&] { s.texture("m"); });
   EXPECT_NE(msg.find("scene.xml:3"), std::string::npos) << msg;
   EXPECT_NE(msg.find("nested texture"), std::string::npos) << msg;
 }

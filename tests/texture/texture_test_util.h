@@ -2,6 +2,8 @@
 // XML snippets through the real parser and LoadContext.
 #pragma once
 
+#include "test_support.h"
+
 #include "tessera/scene/load_context.h"
 
 #include <gtest/gtest.h>
@@ -51,17 +53,6 @@ inline SurfaceInteraction at_uv(float u, float v) {
   SurfaceInteraction si;
   si.uv = Vec2(u, v);
   return si;
-}
-
-template <typename F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const SceneError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected a SceneError";
-  return "";
 }
 
 }  // namespace tessera::test

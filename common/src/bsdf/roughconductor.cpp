@@ -3,6 +3,7 @@
 // Roughness may be a texture (evaluated per hit with eval_1); the distribution object is rebuilt at
 // each call, which costs a few flops.
 #include "tessera/bsdf/conductor.h"
+#include "tessera/bsdf/microfacet_params.h"
 
 #include "tessera/bsdf/fresnel.h"
 #include "tessera/core/check.h"
@@ -77,10 +78,6 @@ class RoughConductorBsdf final : public Bsdf {
   std::shared_ptr<const Texture> specular_reflectance_;
 };
 
-bool has_param(const SceneNode& node, const std::string& name) {
-  return node.find(name) != nullptr || node.named_child(name) != nullptr;
-}
-
 }  // namespace
 
 std::shared_ptr<Bsdf> make_roughconductor_bsdf(MicrofacetType type, std::shared_ptr<const Texture> alpha_u,
@@ -91,28 +88,10 @@ std::shared_ptr<Bsdf> make_roughconductor_bsdf(MicrofacetType type, std::shared_
 }
 
 std::shared_ptr<Bsdf> make_roughconductor(const SceneNode& node, LoadContext& ctx) {
-  std::string dist_name = node.get_string("distribution", "beckmann");
-  std::optional<MicrofacetType> type = parse_microfacet_type(dist_name);
-  if (!type) {
-    const Property* p = node.find("distribution");
-    FileLoc loc = p ? p->loc : node.loc;
-    if (dist_name == "as") {
-      // Mitsuba 0.6's Ashikhmin-Shirley variant: not implemented; Beckmann is the fallback.
-      ctx.unsupported(loc, node.describe() + " distribution 'as'", "beckmann");
-      type = MicrofacetType::Beckmann;
-    } else {
-      throw SceneError(loc, "unknown microfacet distribution '" + dist_name + "' for " + node.describe() +
-                                "; expected beckmann, ggx or phong");
-    }
-  }
-  // Mitsuba 0.6: `alpha` sets both axes; `alpha_u` / `alpha_v` override each (default 0.1).
-  std::shared_ptr<Texture> alpha = ctx.texture(node, "alpha", Rgb(0.1f));
-  std::shared_ptr<Texture> alpha_u = has_param(node, "alpha_u") ? ctx.texture(node, "alpha_u", Rgb(0.1f)) : alpha;
-  std::shared_ptr<Texture> alpha_v = has_param(node, "alpha_v") ? ctx.texture(node, "alpha_v", Rgb(0.1f)) : alpha;
-  // Visible-normal sampling changes only the variance; GGX always uses it, Beckmann/Phong never.
-  node.get_bool("sample_visible", true);
+  const MicrofacetType type = read_microfacet_type(node, ctx);
+  const MicrofacetAlpha alpha = read_microfacet_alpha(node, ctx);
   ConductorIor ior = read_conductor_ior(node);
-  return make_roughconductor_bsdf(*type, alpha_u, alpha_u == alpha_v ? nullptr : alpha_v, ior,
+  return make_roughconductor_bsdf(type, alpha.u, alpha.u == alpha.v ? nullptr : alpha.v, ior,
                                   ctx.texture(node, "specular_reflectance", Rgb(1.f)));
 }
 

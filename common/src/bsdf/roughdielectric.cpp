@@ -9,6 +9,7 @@
 // density where sample() never goes. Mitsuba 0.6's widened sampling roughness
 // (alpha * (1.2 - 0.2 sqrt|cos|)) is not used: sampling uses the distribution of eval().
 #include "tessera/bsdf/roughdielectric.h"
+#include "tessera/bsdf/microfacet_params.h"
 
 #include "tessera/bsdf/fresnel.h"
 #include "tessera/bsdf/ior.h"
@@ -151,10 +152,6 @@ class RoughDielectricBsdf final : public Bsdf {
   std::shared_ptr<const Texture> reflectance_, transmittance_;
 };
 
-bool has_param(const SceneNode& node, const std::string& name) {
-  return node.find(name) != nullptr || node.named_child(name) != nullptr;
-}
-
 }  // namespace
 
 std::shared_ptr<Bsdf> make_roughdielectric_bsdf(MicrofacetType type, std::shared_ptr<const Texture> alpha_u,
@@ -166,29 +163,13 @@ std::shared_ptr<Bsdf> make_roughdielectric_bsdf(MicrofacetType type, std::shared
 }
 
 std::shared_ptr<Bsdf> make_roughdielectric(const SceneNode& node, LoadContext& ctx) {
-  const std::string dist_name = node.get_string("distribution", "beckmann");
-  std::optional<MicrofacetType> type = parse_microfacet_type(dist_name);
-  if (!type) {
-    const Property* p = node.find("distribution");
-    const FileLoc loc = p ? p->loc : node.loc;
-    if (dist_name == "as") {
-      ctx.unsupported(loc, node.describe() + " distribution 'as'", "beckmann");
-      type = MicrofacetType::Beckmann;
-    } else {
-      throw SceneError(loc, "unknown microfacet distribution '" + dist_name + "' for " + node.describe() +
-                                "; expected beckmann, ggx or phong");
-    }
-  }
-  // Mitsuba 0.6: `alpha` sets both axes; `alpha_u` / `alpha_v` override each (default 0.1).
-  std::shared_ptr<Texture> alpha = ctx.texture(node, "alpha", Rgb(0.1f));
-  std::shared_ptr<Texture> alpha_u = has_param(node, "alpha_u") ? ctx.texture(node, "alpha_u", Rgb(0.1f)) : alpha;
-  std::shared_ptr<Texture> alpha_v = has_param(node, "alpha_v") ? ctx.texture(node, "alpha_v", Rgb(0.1f)) : alpha;
-  node.get_bool("sample_visible", true);  // affects variance only (see microfacet.h)
+  const MicrofacetType type = read_microfacet_type(node, ctx);
+  const MicrofacetAlpha alpha = read_microfacet_alpha(node, ctx);
   const float int_ior = read_ior(node, "int_ior", "bk7");
   const float ext_ior = read_ior(node, "ext_ior", "air");
   if (!(int_ior > 0.f) || !(ext_ior > 0.f))
     throw SceneError(node.loc, node.describe() + ": int_ior and ext_ior must be positive");
-  return make_roughdielectric_bsdf(*type, alpha_u, alpha_u == alpha_v ? nullptr : alpha_v, int_ior / ext_ior,
+  return make_roughdielectric_bsdf(type, alpha.u, alpha.u == alpha.v ? nullptr : alpha.v, int_ior / ext_ior,
                                    ctx.texture(node, "specular_reflectance", Rgb(1.f)),
                                    ctx.texture(node, "specular_transmittance", Rgb(1.f)));
 }

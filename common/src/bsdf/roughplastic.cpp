@@ -18,6 +18,8 @@
 // factory reports it and uses the texture's mean.
 #include "tessera/bsdf/roughplastic.h"
 
+#include "tessera/bsdf/microfacet_params.h"
+
 #include "tessera/bsdf/fresnel.h"
 #include "tessera/bsdf/ior.h"
 #include "tessera/core/check.h"
@@ -182,13 +184,7 @@ std::shared_ptr<Bsdf> make_roughplastic_bsdf(MicrofacetType type, float alpha, f
 }
 
 std::shared_ptr<Bsdf> make_roughplastic(const SceneNode& node, LoadContext& ctx) {
-  const std::string dist_name = node.get_string("distribution", "beckmann");
-  const std::optional<MicrofacetType> type = parse_microfacet_type(dist_name);
-  if (!type) {
-    const Property* p = node.find("distribution");
-    throw SceneError(p ? p->loc : node.loc, "unknown microfacet distribution '" + dist_name + "' for " +
-                                                node.describe() + "; expected beckmann, ggx or phong");
-  }
+  const MicrofacetType type = read_microfacet_type(node, ctx);
   const std::shared_ptr<Texture> alpha_tex = ctx.texture(node, "alpha", Rgb(0.1f));
   if (dynamic_cast<const ConstantTexture*>(alpha_tex.get()) == nullptr) {
     const Property* p = node.find("alpha");
@@ -196,13 +192,11 @@ std::shared_ptr<Bsdf> make_roughplastic(const SceneNode& node, LoadContext& ctx)
   }
   const float alpha = alpha_tex->mean().average();
   if (!(alpha > 0.f)) throw SceneError(node.loc, node.describe() + ": alpha must be positive");
-  // Visible-normal sampling changes only the variance; GGX always uses it, Beckmann/Phong never.
-  node.get_bool("sample_visible", true);
   const float int_ior = read_ior(node, "int_ior", "polypropylene");
   const float ext_ior = read_ior(node, "ext_ior", "air");
   if (!(int_ior > 0.f) || !(ext_ior > 0.f))
     throw SceneError(node.loc, node.describe() + ": int_ior and ext_ior must be positive");
-  return make_roughplastic_bsdf(*type, alpha, int_ior / ext_ior,
+  return make_roughplastic_bsdf(type, alpha, int_ior / ext_ior,
                                 ctx.texture(node, "diffuse_reflectance", Rgb(0.5f)),
                                 ctx.texture(node, "specular_reflectance", Rgb(1.f)),
                                 node.get_bool("nonlinear", false));
