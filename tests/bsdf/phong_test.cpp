@@ -6,6 +6,7 @@
 #include "tessera/core/hash.h"
 #include "tessera/scene/load_context.h"
 #include "support/chi2.h"
+#include "bsdf/bsdf_test_util.h"
 
 #include <gtest/gtest.h>
 
@@ -26,12 +27,9 @@ std::shared_ptr<Bsdf> phong(Rgb kd, Rgb ks, float n) {
   return make_phong_bsdf(d, s, constant(Rgb(n)), w);
 }
 
-Vec3 dir(float theta_deg, float phi_deg) {
-  float t = theta_deg * kPi / 180.f, p = phi_deg * kPi / 180.f;
-  return {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
-}
+using test::direction_deg;
 
-const Vec3 kWo[] = {dir(0.f, 0.f), dir(40.f, 30.f), dir(75.f, 200.f), dir(89.f, 100.f)};
+const Vec3 kWo[] = {direction_deg(0.f, 0.f), direction_deg(40.f, 30.f), direction_deg(75.f, 200.f), direction_deg(89.f, 100.f)};
 
 TEST(Phong, Chi2SamplingMatchesPdf) {
   const float exponents[] = {1.f, 10.f, 100.f};
@@ -77,8 +75,8 @@ TEST(Phong, SampleWeightIsEvalOverPdf) {
     }
     BsdfSample bs;
     EXPECT_FALSE(bsdf->sample(si, Vec3(0.f, 0.f, -1.f), 0.5f, {0.5f, 0.5f}, bs));
-    EXPECT_TRUE(bsdf->eval(si, dir(30.f, 0.f), Vec3(0.f, 0.6f, -0.8f)).is_black());
-    EXPECT_EQ(bsdf->pdf(si, Vec3(0.f, 0.6f, -0.8f), dir(30.f, 0.f)), 0.f);
+    EXPECT_TRUE(bsdf->eval(si, direction_deg(30.f, 0.f), Vec3(0.f, 0.6f, -0.8f)).is_black());
+    EXPECT_EQ(bsdf->pdf(si, Vec3(0.f, 0.6f, -0.8f), direction_deg(30.f, 0.f)), 0.f);
   }
 }
 
@@ -86,8 +84,8 @@ TEST(Phong, EvalIsNormalisedLobePlusLambert) {
   SurfaceInteraction si;
   const float n = 12.f;
   auto bsdf = phong(Rgb(0.3f), Rgb(0.6f), n);
-  Vec3 wo = dir(30.f, 0.f);
-  Vec3 wi = dir(40.f, 180.f);  // 10 degrees from the mirror direction dir(30, 180)
+  Vec3 wo = direction_deg(30.f, 0.f);
+  Vec3 wi = direction_deg(40.f, 180.f);  // 10 degrees from the mirror direction direction_deg(30, 180)
   float cos_a = std::cos(10.f * kPi / 180.f);
   float expect = (0.3f / kPi + 0.6f * (n + 2.f) / (2.f * kPi) * std::pow(cos_a, n)) * wi.z;
   EXPECT_NEAR(bsdf->eval(si, wo, wi).g, expect, 1e-5f);
@@ -105,7 +103,7 @@ TEST(Phong, LobeChoiceFollowsSpecularSamplingWeight) {
   EXPECT_NEAR(w, s->mean().luminance() / (s->mean().luminance() + d->mean().luminance()), 1e-6f);
   auto bsdf = make_phong_bsdf(d, s, constant(Rgb(1000.f)), w);
   SurfaceInteraction si;
-  Vec3 wo = dir(30.f, 0.f), mirror = dir(30.f, 180.f);
+  Vec3 wo = direction_deg(30.f, 0.f), mirror = direction_deg(30.f, 180.f);
   BsdfSample bs;
   ASSERT_TRUE(bsdf->sample(si, wo, 0.999f * w, {0.9f, 0.9f}, bs));
   EXPECT_GT(dot(bs.wi, mirror), 0.99f);
@@ -153,7 +151,7 @@ LoadResult load_06(const std::string& body) {
 
 TEST(Phong, LoadsFromMitsuba06Xml) {
   SurfaceInteraction si;
-  Vec3 wo = dir(30.f, 0.f), wi = dir(35.f, 175.f);
+  Vec3 wo = direction_deg(30.f, 0.f), wi = direction_deg(35.f, 175.f);
   auto r = load_06(R"(<shape type="sphere"><bsdf type="phong">
     <rgb name="diffuseReflectance" value="0.7 0.439632 0.1"/>
     <rgb name="specularReflectance" value="0.1 0.1 0.1"/>

@@ -13,6 +13,7 @@
 #include "tessera/core/hash.h"
 #include "tessera/scene/load_context.h"
 #include "support/chi2.h"
+#include "bsdf/bsdf_test_util.h"
 
 #include <gtest/gtest.h>
 
@@ -31,12 +32,9 @@ std::shared_ptr<Bsdf> rough(Rgb rho, float alpha, bool fast) {
   return make_roughdiffuse_bsdf(constant(rho), constant(Rgb(alpha)), fast);
 }
 
-Vec3 dir(float theta_deg, float phi_deg) {
-  float t = theta_deg * kPi / 180.f, p = phi_deg * kPi / 180.f;
-  return {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
-}
+using test::direction_deg;
 
-const Vec3 kWo[] = {dir(0.f, 0.f), dir(45.f, 30.f), dir(80.f, 200.f), dir(89.f, 100.f)};
+const Vec3 kWo[] = {direction_deg(0.f, 0.f), direction_deg(45.f, 30.f), direction_deg(80.f, 200.f), direction_deg(89.f, 100.f)};
 
 TEST(RoughDiffuse, Chi2SamplingMatchesPdf) {
   const float alphas[] = {0.05f, 0.5f, 1.f};
@@ -83,8 +81,8 @@ TEST(RoughDiffuse, SampleWeightIsEvalOverPdf) {
       // One-sided.
       BsdfSample bs;
       EXPECT_FALSE(bsdf->sample(si, Vec3(0.f, 0.f, -1.f), 0.5f, {0.5f, 0.5f}, bs));
-      EXPECT_TRUE(bsdf->eval(si, dir(30.f, 0.f), Vec3(0.f, 0.6f, -0.8f)).is_black());
-      EXPECT_EQ(bsdf->pdf(si, Vec3(0.f, 0.6f, -0.8f), dir(30.f, 0.f)), 0.f);
+      EXPECT_TRUE(bsdf->eval(si, direction_deg(30.f, 0.f), Vec3(0.f, 0.6f, -0.8f)).is_black());
+      EXPECT_EQ(bsdf->pdf(si, Vec3(0.f, 0.6f, -0.8f), direction_deg(30.f, 0.f)), 0.f);
     }
   }
 }
@@ -114,12 +112,12 @@ TEST(RoughDiffuse, WhiteFurnaceAlbedo) {
   for (bool fast : {false, true}) {
     for (float a : {0.05f, 0.3f, 0.7f, 1.f}) {
       auto bsdf = rough(Rgb(1.f), a, fast);
-      for (Vec3 wo : {dir(0.f, 0.f), dir(30.f, 70.f), dir(45.f, 30.f)}) {
+      for (Vec3 wo : {direction_deg(0.f, 0.f), direction_deg(30.f, 70.f), direction_deg(45.f, 30.f)}) {
         double albedo = white_albedo(*bsdf, wo);
         EXPECT_LE(albedo, 1.0 + 2e-3) << "fast " << fast << " alpha " << a << " wo.z " << wo.z;
         EXPECT_GT(albedo, 0.6) << "fast " << fast << " alpha " << a << " wo.z " << wo.z;
       }
-      for (Vec3 wo : {dir(60.f, 10.f), dir(75.f, 300.f), dir(89.f, 100.f)}) {
+      for (Vec3 wo : {direction_deg(60.f, 10.f), direction_deg(75.f, 300.f), direction_deg(89.f, 100.f)}) {
         double albedo = white_albedo(*bsdf, wo);
         EXPECT_LE(albedo, 1.05) << "fast " << fast << " alpha " << a << " wo.z " << wo.z;
       }
@@ -127,7 +125,7 @@ TEST(RoughDiffuse, WhiteFurnaceAlbedo) {
   }
   const float sigma2 = 0.0394f, alpha = std::sqrt(2.f * sigma2);
   const float a = 1.f - 0.5f * sigma2 / (sigma2 + 0.33f), b = 0.45f * sigma2 / (sigma2 + 0.09f);
-  EXPECT_NEAR(white_albedo(*rough(Rgb(1.f), alpha, true), dir(89.f, 0.f), 200000), a + 0.5f * b, 5e-3);
+  EXPECT_NEAR(white_albedo(*rough(Rgb(1.f), alpha, true), direction_deg(89.f, 0.f), 200000), a + 0.5f * b, 5e-3);
 }
 
 TEST(RoughDiffuse, AlphaZeroIsLambert) {
@@ -160,17 +158,17 @@ TEST(RoughDiffuse, FastApproxVsFullModel) {
   EXPECT_NEAR(fast->eval(si, n, n).g, rho * a / kPi, 1e-6f);
   EXPECT_NEAR(full->eval(si, n, n).g, (rho * a + rho * rho * c4) / kPi, 1e-6f);
   // A hand-computed fast-model value: theta_o = 60, theta_i = 30, same azimuth.
-  Vec3 wo = dir(60.f, 0.f), wi = dir(30.f, 0.f);
+  Vec3 wo = direction_deg(60.f, 0.f), wi = direction_deg(30.f, 0.f);
   const float b = 0.45f * sigma2 / (sigma2 + 0.09f);
   const float expect = rho / kPi * wi.z * (a + b * std::sin(kPi / 3.f) * std::tan(kPi / 6.f));
   EXPECT_NEAR(fast->eval(si, wo, wi).g, expect, 1e-5f);
   // Reciprocity (eval / cos wi) holds for both models.
   for (const Bsdf* m : {fast.get(), full.get()}) {
-    Vec3 p = dir(70.f, 10.f), q = dir(20.f, 250.f);
+    Vec3 p = direction_deg(70.f, 10.f), q = direction_deg(20.f, 250.f);
     EXPECT_NEAR(m->eval(si, p, q).g / q.z, m->eval(si, q, p).g / p.z, 1e-5f);
   }
   // Backscattering is brightened relative to Lambert in both models (the Oren–Nayar signature).
-  Vec3 back = dir(70.f, 0.f);
+  Vec3 back = direction_deg(70.f, 0.f);
   EXPECT_GT(fast->eval(si, back, back).g, rho / kPi * back.z);
   EXPECT_GT(full->eval(si, back, back).g, rho / kPi * back.z);
 }
@@ -181,7 +179,7 @@ LoadResult load_06(const std::string& body) {
 
 TEST(RoughDiffuse, LoadsFromMitsuba06Xml) {
   SurfaceInteraction si;
-  Vec3 wo = dir(40.f, 0.f), wi = dir(50.f, 180.f);
+  Vec3 wo = direction_deg(40.f, 0.f), wi = direction_deg(50.f, 180.f);
   auto r = load_06(R"(<shape type="sphere"><bsdf type="roughdiffuse">
     <rgb name="reflectance" value="0.1, 0.2, 0.3"/><float name="alpha" value="0.7"/>
     <boolean name="useFastApprox" value="true"/></bsdf></shape>)");
