@@ -42,13 +42,7 @@ TEST(Phong, Chi2SamplingMatchesPdf) {
     auto bsdf = phong(Rgb(0.4f), Rgb(0.4f), n);
     for (Vec3 wo : kWo) {
       SurfaceInteraction si;
-      auto r = test::chi2_test(
-          test::Chi2Sampler3([&](Vec2 u, float u1) {
-            BsdfSample bs;
-            if (!bsdf->sample(si, wo, u1, u, bs)) return Chi2Sample{Vec3(), 0.f, false};
-            return Chi2Sample{bs.wi, bs.pdf, true};
-          }),
-          [&](Vec3 wi) { return double(bsdf->pdf(si, wo, wi)); }, o);
+      auto r = test::bsdf_chi2_test(*bsdf, si, wo, o);
       EXPECT_TRUE(r.passed) << "exponent " << n << " wo.z " << wo.z << "\n" << r.message;
       // Lobe samples below the horizon are rejected, so the pdf integrates to <= 1.
       EXPECT_LE(r.pdf_integral, 1.0 + 1e-2);

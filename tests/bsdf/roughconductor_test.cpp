@@ -6,6 +6,8 @@
 #include "tessera/core/ray.h"
 #include "support/chi2.h"
 
+#include "bsdf/bsdf_test_util.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -62,13 +64,7 @@ TEST(RoughConductor, Chi2SamplingMatchesPdf) {
           o.phi_bins = 400;
           o.sample_count = 1000000;
         }
-        auto r = test::chi2_test(
-            test::Chi2Sampler3([&](Vec2 u, float u1) {
-              BsdfSample bs;
-              if (!b->sample(si, wo, u1, u, bs)) return test::Chi2Sample{Vec3(), 0.f, false};
-              return test::Chi2Sample{bs.wi, bs.pdf, true};
-            }),
-            [&](Vec3 wi) { return double(b->pdf(si, wo, wi)); }, o);
+        auto r = test::bsdf_chi2_test(*b, si, wo, o);
         EXPECT_TRUE(r.passed) << r.message;
         EXPECT_LE(r.pdf_integral, 1.0 + 1e-2) << o.name;
       }

@@ -48,13 +48,7 @@ TEST(RoughDiffuse, Chi2SamplingMatchesPdf) {
     auto bsdf = rough(Rgb(0.5f), a, false);
     for (Vec3 wo : kWo) {
       SurfaceInteraction si;
-      auto r = test::chi2_test(
-          test::Chi2Sampler3([&](Vec2 u, float u1) {
-            BsdfSample bs;
-            if (!bsdf->sample(si, wo, u1, u, bs)) return Chi2Sample{Vec3(), 0.f, false};
-            return Chi2Sample{bs.wi, bs.pdf, true};
-          }),
-          [&](Vec3 wi) { return double(bsdf->pdf(si, wo, wi)); }, o);
+      auto r = test::bsdf_chi2_test(*bsdf, si, wo, o);
       EXPECT_TRUE(r.passed) << "alpha " << a << " wo.z " << wo.z << "\n" << r.message;
       EXPECT_NEAR(r.pdf_integral, 1.0, 1e-2);
     }
