@@ -18,6 +18,8 @@
 // factory reports it and uses the texture's mean.
 #include "tessera/bsdf/roughplastic.h"
 
+#include "tessera/bsdf/rough_transmittance.h"
+
 #include "tessera/bsdf/microfacet_params.h"
 
 #include "tessera/bsdf/fresnel.h"
@@ -28,66 +30,11 @@
 #include "tessera/scene/load_context.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 
 namespace tessera {
 
-float rough_dielectric_transmittance(MicrofacetType type, float alpha, float eta, float cos_theta_o) {
-  constexpr int kGrid = 64;
-  const MicrofacetDistribution distr(type, alpha);
-  const float c = std::clamp(cos_theta_o, 1e-4f, 1.f);
-  const Vec3 wo(std::sqrt(std::max(0.f, 1.f - c * c)), 0.f, c);
-  double sum = 0.0;
-  for (int i = 0; i < kGrid; ++i) {
-    for (int j = 0; j < kGrid; ++j) {
-      MicrofacetSample ms;
-      if (!distr.sample_m(wo, Vec2((i + 0.5f) / kGrid, (j + 0.5f) / kGrid), ms) || !(ms.pdf > 0.f)) continue;
-      const float wo_m = dot(wo, ms.m);
-      if (wo_m <= 0.f) continue;
-      float cos_t = 0.f;
-      const float f = fresnel_dielectric(wo_m, eta, &cos_t);
-      if (f >= 1.f) continue;  // total internal reflection
-      // Refraction about m (cos_t < 0: the far side of the micro-facet).
-      const Vec3 wt = (-1.f / eta) * wo + (wo_m / eta + cos_t) * ms.m;
-      if (cos_theta(wt) >= 0.f) continue;
-      // Walter et al.'s estimator of the transmitted fraction: (1 - F) D G |wo.m| / (cos_o pdf_m).
-      sum += double((1.f - f) * distr.D(ms.m) * distr.G(wo, wt, ms.m) * wo_m / (c * ms.pdf));
-    }
-  }
-  return float(std::min(1.0, sum / (kGrid * kGrid)));
-}
-
 namespace {
-
-constexpr int kTableSize = 64;
-
-// T(c) sampled at c = k / (kTableSize - 1).
-class TransmittanceTable {
- public:
-  TransmittanceTable(MicrofacetType type, float alpha, float eta) {
-    for (int k = 0; k < kTableSize; ++k)
-      t_[k] = rough_dielectric_transmittance(type, alpha, eta, float(k) / (kTableSize - 1));
-  }
-
-  float eval(float c) const {
-    const float x = std::clamp(c, 0.f, 1.f) * (kTableSize - 1);
-    const int k = std::min(int(x), kTableSize - 2);
-    const float f = x - float(k);
-    return (1.f - f) * t_[k] + f * t_[k + 1];
-  }
-
-  /// 2 int_0^1 T(c) c dc = int_0^1 T(sqrt(x)) dx, midpoint rule in x.
-  float cosine_average() const {
-    constexpr int kSteps = 4096;
-    double sum = 0.0;
-    for (int i = 0; i < kSteps; ++i) sum += eval(std::sqrt((i + 0.5f) / kSteps));
-    return float(sum / kSteps);
-  }
-
- private:
-  std::array<float, kTableSize> t_{};
-};
 
 class RoughPlasticBsdf final : public Bsdf {
  public:

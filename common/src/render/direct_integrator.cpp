@@ -47,10 +47,11 @@ class DirectIntegrator final : public Integrator {
       if (f.is_black()) continue;
       Ray shadow = ls.dist < kInfinity ? spawn_ray_to(si.p, si.ng, ls.p_light) : spawn_ray(si.p, si.ng, ls.wi);
       ++counters.shadow_rays;
-      if (scene.occluded(shadow)) continue;
+      const float tr = scene.transmittance(shadow);
+      if (!(tr > 0.f)) continue;
       float light_pdf = ls.pdf * pmf;
       float w = ls.delta ? 1.f : power_heuristic(fn_l * light_pdf, fn_b * bsdf->pdf(si, wo, wi));
-      L += f * ls.li * (w / (light_pdf * fn_l));
+      L += f * ls.li * (tr * w / (light_pdf * fn_l));
     }
 
     for (int j = 0; j < n_b; ++j) {

@@ -108,10 +108,11 @@ class PathIntegrator final : public Integrator {
     if (f.is_black()) return {};
     Ray shadow = ls.dist < kInfinity ? spawn_ray_to(si.p, si.ng, ls.p_light) : spawn_ray(si.p, si.ng, ls.wi);
     ++counters.shadow_rays;
-    if (scene.occluded(shadow)) return {};
+    const float tr = scene.transmittance(shadow);
+    if (!(tr > 0.f)) return {};
     float light_pdf = ls.pdf * pmf;
     float w = ls.delta ? 1.f : power_heuristic(light_pdf, bsdf.pdf(si, wo, wi));
-    return f * ls.li * (w / light_pdf);
+    return f * ls.li * (tr * w / light_pdf);
   }
 
   IntegratorSettings s_;

@@ -1,8 +1,10 @@
 #include "tessera/render/scene.h"
 
 #include "tessera/core/check.h"
+#include "tessera/core/hash.h"
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 
 namespace tessera {
@@ -41,6 +43,8 @@ void Scene::finalize() {
     }
   }
   num_triangles_ = tri_count;
+  has_masks_ = std::any_of(shapes.begin(), shapes.end(),
+                           [](const auto& s) { return s->bsdf && s->bsdf->has_opacity(); });
   auto t0 = std::chrono::steady_clock::now();
   accel_ = Bvh::build(std::move(triangles), std::move(spheres));
   bvh_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -59,15 +63,78 @@ void Scene::finalize() {
   light_distr_ = Distribution1D(power);
 }
 
-bool Scene::intersect(const Ray& ray, SurfaceInteraction& si) const {
-  Hit hit;
-  if (!accel_.intersect(ray, hit)) return false;
+void Scene::fill(const Ray& ray, const Hit& hit, SurfaceInteraction& si) const {
   TESSERA_DCHECK(hit.prim < prim_shape_.size());
   uint32_t shape_index = prim_shape_[hit.prim];
   const Shape* shape = shapes[shape_index].get();
   shape->fill_interaction(ray, hit, hit.prim - shape_first_[shape_index], si);
   si.shape = shape;
+}
+
+namespace {
+
+// Beyond this many masked surfaces along one ray the next one counts as opaque: bounds the work
+// of a ray through a dense stack of cut-outs (a hedge seen end-on) at a negligible bias.
+constexpr int kMaxMaskCrossings = 64;
+
+float masked_opacity(const SurfaceInteraction& si) {
+  const Bsdf* bsdf = si.bsdf();
+  return bsdf && bsdf->has_opacity() ? bsdf->opacity(si) : 1.f;
+}
+
+// A uniform number from the ray itself (as pbrt-v4's alpha test): deterministic, independent of
+// the sampler's dimension layout, and different for every ray that differs in a bit.
+float alpha_test_u(const Ray& r) {
+  auto b = [](float f) { return uint64_t(std::bit_cast<uint32_t>(f)); };
+  uint64_t h = hash_values(b(r.o.x) | b(r.o.y) << 32, b(r.o.z) | b(r.d.x) << 32, b(r.d.y) | b(r.d.z) << 32);
+  return bits_to_unit_float(uint32_t(h >> 32));
+}
+
+// The continuation of `r` past a surface hit at parameter t: same direction and parametrisation,
+// origin offset past the surface, the remaining range kept.
+Ray continue_ray(const Ray& r, const SurfaceInteraction& si, float t) {
+  Ray next = r;
+  next.o = offset_ray_origin(si.p, dot(r.d, si.ng) < 0.f ? -si.ng : si.ng);
+  next.tmax = r.tmax - t;
+  return next;
+}
+
+}  // namespace
+
+bool Scene::intersect(const Ray& ray, SurfaceInteraction& si) const {
+  Hit hit;
+  if (!accel_.intersect(ray, hit)) return false;
+  fill(ray, hit, si);
+  if (!has_masks_) return true;
+  Ray r = ray;
+  float t_before = 0.f;  // parameter of r.o along the original ray
+  for (int crossing = 0; crossing < kMaxMaskCrossings; ++crossing) {
+    float opacity = masked_opacity(si);
+    if (opacity >= 1.f || alpha_test_u(r) < opacity) break;
+    t_before += si.t;
+    r = continue_ray(r, si, si.t);
+    if (!(r.tmax > 0.f) || !accel_.intersect(r, hit)) return false;
+    fill(r, hit, si);
+  }
+  si.t += t_before;
   return true;
+}
+
+float Scene::transmittance(const Ray& ray) const {
+  if (!has_masks_) return accel_.occluded(ray) ? 0.f : 1.f;
+  Ray r = ray;
+  float tr = 1.f;
+  SurfaceInteraction si;
+  for (int crossing = 0; crossing <= kMaxMaskCrossings; ++crossing) {
+    Hit hit;
+    if (!accel_.intersect(r, hit)) return tr;
+    fill(r, hit, si);
+    tr *= 1.f - masked_opacity(si);
+    if (!(tr > 0.f) || crossing == kMaxMaskCrossings) return 0.f;
+    r = continue_ray(r, si, si.t);
+    if (!(r.tmax > 0.f)) return tr;
+  }
+  return 0.f;
 }
 
 const Light* Scene::sample_light(float u, float& pmf) const {

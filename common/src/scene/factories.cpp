@@ -19,6 +19,12 @@ std::shared_ptr<Bsdf> make_roughdielectric(const SceneNode&, LoadContext&);
 std::shared_ptr<Bsdf> make_thindielectric(const SceneNode&, LoadContext&);
 std::shared_ptr<Bsdf> make_plastic(const SceneNode&, LoadContext&);
 std::shared_ptr<Bsdf> make_roughplastic(const SceneNode&, LoadContext&);
+std::shared_ptr<Bsdf> make_bumpmap(const SceneNode&, LoadContext&);
+std::shared_ptr<Bsdf> make_normalmap(const SceneNode&, LoadContext&);
+std::shared_ptr<Bsdf> make_blendbsdf(const SceneNode&, LoadContext&);
+std::shared_ptr<Bsdf> make_coating(const SceneNode&, LoadContext&);
+std::shared_ptr<Bsdf> make_roughcoating(const SceneNode&, LoadContext&);
+std::shared_ptr<Bsdf> make_mask(const SceneNode&, LoadContext&);
 // -- textures --
 std::shared_ptr<Texture> make_bitmap(const SceneNode&, LoadContext&);
 std::shared_ptr<Texture> make_checkerboard(const SceneNode&, LoadContext&);
@@ -63,6 +69,12 @@ const Entry<BsdfFactory> kBsdfs[] = {
     {"thindielectric", make_thindielectric},
     {"plastic", make_plastic},
     {"roughplastic", make_roughplastic},
+    {"bumpmap", make_bumpmap},
+    {"normalmap", make_normalmap},
+    {"blendbsdf", make_blendbsdf},
+    {"coating", make_coating},
+    {"roughcoating", make_roughcoating},
+    {"mask", make_mask},
     {"", nullptr},
 };
 const Entry<TextureFactory> kTextures[] = {
@@ -88,7 +100,27 @@ const Entry<ShapeFactory> kShapes[] = {
     {"", nullptr},
 };
 
+template <typename F, size_t N>
+std::vector<std::string> names(const Entry<F> (&table)[N]) {
+  std::vector<std::string> out;
+  for (const auto& e : table)
+    if (!e.type.empty()) out.emplace_back(e.type);
+  return out;
+}
+
 }  // namespace
+
+std::vector<std::string> registered_plugins(const std::string& tag) {
+  if (tag == "bsdf") return names(kBsdfs);
+  if (tag == "texture") return names(kTextures);
+  if (tag == "shape") return names(kShapes);
+  if (tag == "emitter") {
+    auto out = names(kLights);
+    out.push_back("area");  // made by the shape loader, not a table entry
+    return out;
+  }
+  return {};
+}
 
 BsdfFactory find_bsdf_factory(const std::string& type) { return type.empty() ? nullptr : find(kBsdfs, type); }
 TextureFactory find_texture_factory(const std::string& type) { return type.empty() ? nullptr : find(kTextures, type); }

@@ -122,7 +122,7 @@ class ShapeBuilder {
     }
     shape->bsdf = bsdf;
     shape->name = node.describe();
-    const Property* file = node.find("filename");
+    const Property* file = node.peek("filename");
     if (file && file->type == PropType::String) shape->name += " (" + file->s + ")";
     attach_emitter(node, *shape, in_group);
     st_.scene.shapes.push_back(std::move(shape));

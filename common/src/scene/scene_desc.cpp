@@ -2,6 +2,8 @@
 // property was written; every successful look-up marks the property consumed.
 #include "tessera/scene/scene_desc.h"
 
+#include "tessera/scene/parameter_log.h"
+
 namespace tessera {
 
 namespace {
@@ -27,6 +29,11 @@ const char* type_name(PropType t) {
 }  // namespace
 
 const Property* SceneNode::find(const std::string& n) const {
+  ParameterLog::record(*this, n);
+  return peek(n);
+}
+
+const Property* SceneNode::peek(const std::string& n) const {
   for (const Property& p : props)
     if (p.name == n) return &p;
   return nullptr;
@@ -105,6 +112,7 @@ std::vector<std::shared_ptr<SceneNode>> SceneNode::children_with_tag(const std::
 }
 
 std::shared_ptr<SceneNode> SceneNode::named_child(const std::string& n) const {
+  ParameterLog::record(*this, n);
   for (size_t i = 0; i < children.size() && i < child_names.size(); ++i)
     if (child_names[i] == n) return children[i];
   return nullptr;

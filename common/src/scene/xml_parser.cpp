@@ -314,8 +314,14 @@ class Parser {
     std::string written;
     FileLoc loc;
     bool any = false;
+    // Scanned directly: SceneNode::find is for plugins and logs what they ask for.
+    auto prop_named = [&node](const char* name) -> const Property* {
+      for (const Property& p : node.props)
+        if (p.name == name) return &p;
+      return nullptr;
+    };
     for (int i = 0; i < 4; ++i) {
-      const Property* p = node.find(kNames[i]);
+      const Property* p = prop_named(kNames[i]);
       if (!p) continue;
       if (p->type != PropType::Float && p->type != PropType::Integer) return;  // the getter reports it
       v[i] = p->type == PropType::Float ? p->f : double(p->i);
@@ -323,7 +329,7 @@ class Parser {
       if (!any || p->loc.line < loc.line) loc = p->loc;
       any = true;
     }
-    if (!any || node.has("to_uv")) return;
+    if (!any || prop_named("to_uv")) return;
     Transform to_uv = Transform::translate(Vec3(float(v[0]), float(v[1]), 0.f)) *
                       Transform::scale(Vec3(float(v[2]), float(v[3]), 1.f));
     if (!Transform::from_matrix(to_uv.matrix()))

@@ -42,6 +42,17 @@ void SphereShape::fill_interaction(const Ray& ray, const Hit& hit, uint32_t prim
   if (phi < 0.f) phi += 2.f * kPi;
   float theta = std::acos(std::fmin(1.f, std::fmax(-1.f, n.z)));
   si.uv = Vec2(phi * kInv2Pi, theta * kInvPi);
+  // Derivatives of p = c + r (sin v*pi cos u*2pi, sin v*pi sin u*2pi, cos v*pi); they vanish or
+  // lose their direction at the poles, where any tangent pair will do.
+  const Vec3 q = n * radius_;
+  const float rxy = std::sqrt(q.x * q.x + q.y * q.y);
+  if (rxy > 1e-6f * radius_) {
+    const float cos_phi = q.x / rxy, sin_phi = q.y / rxy;
+    si.dpdu = Vec3(-q.y, q.x, 0.f) * (2.f * kPi);
+    si.dpdv = Vec3(q.z * cos_phi, q.z * sin_phi, -rxy) * kPi;
+  } else {
+    coordinate_system(si.ng, si.dpdu, si.dpdv);
+  }
   si.wo = normalize(-ray.d);
   si.shape = this;
   si.prim = prim;

@@ -103,12 +103,27 @@ void TriangleMeshShape::fill_interaction(const Ray& ray, const Hit& hit, uint32_
   }
   si.shading = Frame(ns);
 
+  bool have_dpduv = false;
   if (!mesh_->uvs.empty()) {
     const auto& uv = mesh_->uvs;
-    si.uv = uv[idx[0]] * b0 + uv[idx[1]] * b1 + uv[idx[2]] * b2;
+    const Vec2 uv0 = uv[idx[0]], uv1 = uv[idx[1]], uv2 = uv[idx[2]];
+    si.uv = uv0 * b0 + uv1 * b1 + uv2 * b2;
+    // pbrt's solve of [dp02 dp12] = [dpdu dpdv] [duv02 duv12] (per hit: a 2x2 inverse is cheaper
+    // than storing six floats per triangle).
+    const Vec2 duv02 = uv0 - uv2, duv12 = uv1 - uv2;
+    const float det = duv02.x * duv12.y - duv02.y * duv12.x;
+    if (det != 0.f) {
+      const float inv = 1.f / det;
+      const Vec3 dp02 = tri.p0 - tri.p2, dp12 = tri.p1 - tri.p2;
+      si.dpdu = (dp02 * duv12.y - dp12 * duv02.y) * inv;
+      si.dpdv = (dp12 * duv02.x - dp02 * duv12.x) * inv;
+      // A tiny determinant can still overflow, and collinear results span no plane.
+      have_dpduv = is_finite(si.dpdu) && is_finite(si.dpdv) && usable(cross(si.dpdu, si.dpdv));
+    }
   } else {
     si.uv = Vec2(b1, b2);  // Mitsuba 3's parameterization of a mesh without uvs
   }
+  if (!have_dpduv) coordinate_system(si.ng, si.dpdu, si.dpdv);
   si.wo = normalize(-ray.d);
   si.shape = this;
   si.prim = prim;

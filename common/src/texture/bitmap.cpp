@@ -60,17 +60,20 @@ int BitmapTexture::wrap(int i, int n, WrapMode mode) {
   return -1;
 }
 
+template <typename T, typename Fetch>
+T BitmapTexture::texel(int x, int y, Fetch fetch) const {
+  // u decided first, as Mitsuba does.
+  int xi = wrap(x, image_->width(), wrap_u_);
+  if (xi < 0) return T(xi == -1 ? 0.f : 1.f);
+  int yi = wrap(y, image_->height(), wrap_v_);
+  if (yi < 0) return T(yi == -1 ? 0.f : 1.f);
+  return fetch(xi, yi);
+}
+
 template <typename Fetch>
 auto BitmapTexture::filtered(Vec2 uv, Fetch fetch) const {
   using T = decltype(fetch(0, 0));
-  // Texel index -> value with Mitsuba's boundary handling (u decided first, as Mitsuba does).
-  auto texel = [&](int x, int y) -> T {
-    int xi = wrap(x, image_->width(), wrap_u_);
-    if (xi < 0) return T(xi == -1 ? 0.f : 1.f);
-    int yi = wrap(y, image_->height(), wrap_v_);
-    if (yi < 0) return T(yi == -1 ? 0.f : 1.f);
-    return fetch(xi, yi);
-  };
+  auto texel = [&](int x, int y) -> T { return this->texel<T>(x, y, fetch); };
   float u = uv.x * float(image_->width()), v = uv.y * float(image_->height());
   // NaN/huge coordinates would overflow the integer conversion; Mitsuba returns 0 for NaN.
   if (!(std::abs(u) < 1e9f) || !(std::abs(v) < 1e9f)) return T(0.f);
@@ -100,6 +103,31 @@ float BitmapTexture::eval_1(const SurfaceInteraction& si) const {
   Vec2 uv = to_uv_.apply(si.uv);
   if (image_->channels() == 1) return lookup_channel(uv, 0);
   return lookup(uv).average();
+}
+
+Vec2 BitmapTexture::lookup_gradient_1(Vec2 uv) const {
+  if (filter_ == TextureFilter::Nearest) return {};
+  const Image& im = *image_;
+  // The same scalar as eval_1: channel 0 of grey images, else the mean of r, g, b.
+  auto fetch = [&im](int x, int y) {
+    return im.channels() == 1 ? im.at(x, y, 0) : im.rgb(x, y).average();
+  };
+  const float w = float(im.width()), h = float(im.height());
+  float u = uv.x * w, v = uv.y * h;
+  if (!(std::abs(u) < 1e9f) || !(std::abs(v) < 1e9f)) return {};
+  u -= 0.5f;
+  v -= 0.5f;
+  float fx = std::floor(u), fy = std::floor(v);
+  int x = int(fx), y = int(fy);
+  float dx = u - fx, dy = v - fy;
+  float p00 = texel<float>(x, y, fetch), p10 = texel<float>(x + 1, y, fetch);
+  float p01 = texel<float>(x, y + 1, fetch), p11 = texel<float>(x + 1, y + 1, fetch);
+  // d/du of the bilinear blend; the texel spacing is 1/w in u and 1/h in v.
+  return {((p10 - p00) * (1.f - dy) + (p11 - p01) * dy) * w, ((p01 - p00) * (1.f - dx) + (p11 - p10) * dx) * h};
+}
+
+Vec2 BitmapTexture::eval_1_gradient(const SurfaceInteraction& si) const {
+  return to_uv_.pull_back(lookup_gradient_1(to_uv_.apply(si.uv)));
 }
 
 Image decode_bitmap_values(const Image& stored, float gamma, bool raw) {

@@ -20,6 +20,9 @@ class CheckerboardTexture final : public Texture {
     return first_colour(si) ? color0_->eval_1(si) : color1_->eval_1(si);
   }
   Rgb mean() const override { return (color0_->mean() + color1_->mean()) * 0.5f; }
+  // Zero: the cells' step edges have no finite derivative, and a bump map must not spike there.
+  // Textured colours are not differentiated either, so a checkerboard height field is flat.
+  Vec2 eval_1_gradient(const SurfaceInteraction&) const override { return {}; }
 
  private:
   // Mitsuba 0.6: color0 where the cells' parities in u and v agree, i.e. on [0,.5)^2. Cells are

@@ -10,6 +10,11 @@ class ScaleTexture final : public Texture {
   ScaleTexture(std::shared_ptr<Texture> nested, Rgb scale) : nested_(std::move(nested)), scale_(scale) {}
   Rgb eval(const SurfaceInteraction& si) const override { return nested_->eval(si) * scale_; }
   Rgb mean() const override { return nested_->mean() * scale_; }
+  // Exact for a grey scale (what bump maps use); a coloured one is reduced to its average, since
+  // the nested gradient is already a scalar.
+  Vec2 eval_1_gradient(const SurfaceInteraction& si) const override {
+    return nested_->eval_1_gradient(si) * scale_.average();
+  }
 
  private:
   std::shared_ptr<Texture> nested_;

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "tessera/bsdf/microfacet.h"
+#include "tessera/bsdf/rough_transmittance.h"
 #include "tessera/render/bsdf.h"
 #include "tessera/render/texture.h"
 
@@ -14,9 +15,5 @@ namespace tessera {
 std::shared_ptr<Bsdf> make_roughplastic_bsdf(MicrofacetType type, float alpha, float eta,
                                              std::shared_ptr<const Texture> diffuse_reflectance,
                                              std::shared_ptr<const Texture> specular_reflectance, bool nonlinear);
-
-/// Fraction of light arriving at cos_theta_o in (0, 1] that a rough dielectric interface transmits
-/// (directional albedo of its transmission lobe); exposed for tests. `eta` < 1: arriving from inside.
-float rough_dielectric_transmittance(MicrofacetType type, float alpha, float eta, float cos_theta_o);
 
 }  // namespace tessera

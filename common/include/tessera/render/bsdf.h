@@ -35,6 +35,14 @@ class Bsdf {
                       BsdfSample& out) const = 0;
   /// True when every lobe is a delta (no next-event estimation possible).
   virtual bool is_delta() const { return false; }
+  /// True when the BSDF (Mitsuba's `mask`, or a wrapper around one) lets part of the light pass
+  /// straight through the surface. Wrappers (twosided, bumpmap, ...) must forward both methods.
+  virtual bool has_opacity() const { return false; }
+  /// Fraction of light the surface stops at `si`, in [0, 1]. The integrator applies it, not
+  /// eval()/sample(): a ray hitting the surface passes through with probability 1 - opacity
+  /// (Scene::intersect), and shadow rays are attenuated by 1 - opacity (Scene::transmittance).
+  /// So eval()/pdf()/sample() of a masked BSDF describe the opaque part only.
+  virtual float opacity(const SurfaceInteraction&) const { return 1.f; }
 };
 
 }  // namespace tessera

@@ -20,6 +20,11 @@ struct SurfaceInteraction {
                        // order / outward for analytic shapes, flipped by flip_normals)
   Frame shading;       // shading frame; shading.n is the interpolated normal, on ng's side
   Vec2 uv;
+  // World-space dp/du and dp/dv (texture-space position derivatives, unnormalised); the bump and
+  // normal maps build their tangent frames from them. Shapes without a usable parameterisation
+  // give an orthonormal tangent pair of ng. The defaults match the default shading frame.
+  Vec3 dpdu{1.f, 0.f, 0.f};
+  Vec3 dpdv{0.f, 1.f, 0.f};
   Vec3 wo;             // unit direction back towards the ray origin (world)
   const Shape* shape = nullptr;
   uint32_t prim = 0;   // triangle index within the shape

@@ -52,8 +52,18 @@ class Scene {
   /// light's preprocess(). Call once after every object was added.
   void finalize();
 
+  /// Closest hit along `ray`. Surfaces with opacity (Bsdf::opacity, Mitsuba's `mask`) are passed
+  /// through with probability 1 - opacity, decided by a hash of the ray (so the image stays a
+  /// function of scene, pixel, sample and seed); si.t is then measured from ray.o as usual.
   bool intersect(const Ray& ray, SurfaceInteraction& si) const;
+  /// Any hit, ignoring opacity: for callers that want geometry only (opaque scenes: the same as a
+  /// shadow ray's visibility).
   bool occluded(const Ray& ray) const { return accel_.occluded(ray); }
+  /// Fraction of light that gets along a shadow-ray segment: 0 when an opaque surface blocks it,
+  /// otherwise the product of (1 - opacity) over the masked surfaces crossed.
+  float transmittance(const Ray& ray) const;
+  /// True when some shape's BSDF has opacity (else intersect/transmittance take the fast path).
+  bool has_masks() const { return has_masks_; }
 
   /// Picks a light in proportion to power. Null when the scene has none.
   const Light* sample_light(float u, float& pmf) const;
@@ -73,6 +83,9 @@ class Scene {
   std::vector<const Light*> infinite_lights_;
   size_t num_triangles_ = 0;
   double bvh_seconds_ = 0;
+  bool has_masks_ = false;
+
+  void fill(const Ray& ray, const Hit& hit, SurfaceInteraction& si) const;
 };
 
 }  // namespace tessera

@@ -11,6 +11,9 @@ class Texture {
   virtual ~Texture() = default;
   virtual Rgb eval(const SurfaceInteraction& si) const = 0;
   virtual float eval_1(const SurfaceInteraction& si) const { return eval(si).average(); }
+  /// (d/du, d/dv) of eval_1 at si, per unit of si.uv: what bump mapping differentiates (Mitsuba
+  /// 0.6's evalGradient). Zero by default, which is exact for constant textures.
+  virtual Vec2 eval_1_gradient(const SurfaceInteraction&) const { return {}; }
   /// Mean value over the texture; used to estimate light power and for fallbacks.
   virtual Rgb mean() const = 0;
 };

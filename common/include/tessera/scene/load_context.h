@@ -116,6 +116,8 @@ BsdfFactory find_bsdf_factory(const std::string& type);
 TextureFactory find_texture_factory(const std::string& type);
 LightFactory find_light_factory(const std::string& type);
 ShapeFactory find_shape_factory(const std::string& type);
+/// Plugin types of one factory table ("bsdf", "texture", "shape", "emitter"), in table order.
+std::vector<std::string> registered_plugins(const std::string& tag);
 
 struct LoadResult {
   std::unique_ptr<Scene> scene;

@@ -54,6 +54,8 @@ struct SceneNode {
   // Typed look-ups; they mark the property used. A present property of the wrong type throws
   // SceneError naming file, line and property.
   const Property* find(const std::string& name) const;
+  /// find() for messages: not logged as a parameter the plugin reads (scene/parameter_log.h).
+  const Property* peek(const std::string& name) const;
   bool has(const std::string& name) const { return find(name) != nullptr; }
   float get_float(const std::string& name, float def) const;
   int64_t get_int(const std::string& name, int64_t def) const;

@@ -31,6 +31,9 @@ class UvMapping {
   Vec2 apply(Vec2 uv) const {
     return {m_[0] * uv.x + m_[1] * uv.y + m_[2], m_[3] * uv.x + m_[4] * uv.y + m_[5]};
   }
+  /// Chain rule: a gradient with respect to the mapped uv' -> the gradient with respect to uv
+  /// (multiplied by the transposed linear part).
+  Vec2 pull_back(Vec2 g) const { return {m_[0] * g.x + m_[3] * g.y, m_[1] * g.x + m_[4] * g.y}; }
 
  private:
   float m_[6] = {1, 0, 0, 0, 1, 0};
@@ -44,6 +47,9 @@ class BitmapTexture final : public Texture {
 
   Rgb eval(const SurfaceInteraction& si) const override { return lookup(to_uv_.apply(si.uv)); }
   float eval_1(const SurfaceInteraction& si) const override;
+  /// Derivative of the bilinear interpolation (Mitsuba 0.6's evalGradientBilinear at the finest
+  /// level), through to_uv; zero for the nearest filter, as in Mitsuba.
+  Vec2 eval_1_gradient(const SurfaceInteraction& si) const override;
   /// Alpha channel at the surface point (1 for images without alpha); for masks.
   float alpha(const SurfaceInteraction& si) const { return lookup_channel(to_uv_.apply(si.uv), 3); }
   Rgb mean() const override { return mean_; }
@@ -60,8 +66,13 @@ class BitmapTexture final : public Texture {
  private:
   /// Resolves a texel index against the wrap mode; -1 = outside (Zero/One).
   static int wrap(int i, int n, WrapMode mode);
+  /// Texel value with Mitsuba's boundary handling; `fetch` reads an in-range texel.
+  template <typename T, typename Fetch>
+  T texel(int x, int y, Fetch fetch) const;
   template <typename Fetch>
   auto filtered(Vec2 uv, Fetch fetch) const;
+  /// Gradient of the scalar bilinear interpolant at mapped coordinates.
+  Vec2 lookup_gradient_1(Vec2 uv) const;
 
   std::shared_ptr<const Image> image_;
   WrapMode wrap_u_, wrap_v_;

@@ -1,0 +1,72 @@
+// Mitsuba's `mask`: a nested BSDF with an opacity texture. Mitsuba 0.6 models the transparent part
+// as a delta-transmission lobe of the BSDF; Tessera applies it at intersection time instead
+// (Scene::intersect skips the surface with probability 1 - opacity, Scene::transmittance
+// attenuates shadow rays by 1 - opacity). The expected image is the same, and shadows of masked
+// geometry (leaves, rugs) come out right for next-event estimation too, which a delta lobe cannot
+// give: a shadow ray never samples a delta direction.
+#include "tessera/bsdf/mask.h"
+
+#include "tessera/core/check.h"
+#include "tessera/scene/load_context.h"
+#include "tessera/texture/bitmap.h"
+
+#include <algorithm>
+
+namespace tessera {
+namespace {
+
+class MaskBsdf final : public Bsdf {
+ public:
+  MaskBsdf(const Bsdf* nested, std::shared_ptr<const Texture> opacity, OpacitySource source)
+      : nested_(nested), opacity_(std::move(opacity)), source_(source) {
+    TESSERA_CHECK(nested_ != nullptr && opacity_ != nullptr);
+    bitmap_ = dynamic_cast<const BitmapTexture*>(opacity_.get());
+    TESSERA_CHECK(source_ != OpacitySource::Alpha || bitmap_ != nullptr);
+  }
+
+  Rgb eval(const SurfaceInteraction& si, Vec3 wo, Vec3 wi) const override { return nested_->eval(si, wo, wi); }
+  float pdf(const SurfaceInteraction& si, Vec3 wo, Vec3 wi) const override { return nested_->pdf(si, wo, wi); }
+  bool sample(const SurfaceInteraction& si, Vec3 wo, float u1, Vec2 u2, BsdfSample& out) const override {
+    return nested_->sample(si, wo, u1, u2, out);
+  }
+  bool is_delta() const override { return nested_->is_delta(); }
+  bool has_opacity() const override { return true; }
+
+  float opacity(const SurfaceInteraction& si) const override {
+    float a = source_ == OpacitySource::Alpha ? bitmap_->alpha(si) : opacity_->eval(si).luminance();
+    // NaN texels count as opaque: a hole is the more visible error.
+    if (!(a >= 0.f)) return a < 0.f ? 0.f : 1.f;
+    float own = std::min(a, 1.f);
+    // A mask around a mask (rare) stops the light either layer stops.
+    return nested_->has_opacity() ? 1.f - (1.f - own) * (1.f - nested_->opacity(si)) : own;
+  }
+
+ private:
+  const Bsdf* nested_;
+  std::shared_ptr<const Texture> opacity_;
+  const BitmapTexture* bitmap_ = nullptr;
+  OpacitySource source_;
+};
+
+}  // namespace
+
+std::shared_ptr<Bsdf> make_mask_bsdf(const Bsdf* nested, std::shared_ptr<const Texture> opacity,
+                                     OpacitySource source) {
+  return std::make_shared<MaskBsdf>(nested, std::move(opacity), source);
+}
+
+std::shared_ptr<Bsdf> make_mask(const SceneNode& node, LoadContext& ctx) {
+  auto nested = node.children_with_tag("bsdf");
+  if (nested.size() != 1)
+    throw SceneError(node.loc, node.describe() + ": expected one nested BSDF, found " +
+                                   std::to_string(nested.size()));
+  std::shared_ptr<const Texture> opacity = ctx.texture(node, "opacity", Rgb(0.5f));
+  // An image with an alpha channel is a cut-out: its colour channels hold the picture (often white
+  // where alpha is 0, as in the living room's leaf.png), so its alpha is the opacity. Mitsuba 3,
+  // whose renders are our references, shows such leaves as cut-outs too.
+  auto* bitmap = dynamic_cast<const BitmapTexture*>(opacity.get());
+  OpacitySource source = bitmap && bitmap->image()->has_alpha() ? OpacitySource::Alpha : OpacitySource::Luminance;
+  return make_mask_bsdf(ctx.bsdf(nested[0]), std::move(opacity), source);
+}
+
+}  // namespace tessera

@@ -1,0 +1,217 @@
+// Mitsuba's `mask`: rays pass a masked surface with probability 1 - opacity (a binomial / chi-square
+// test on the choice), shadow rays are attenuated by exactly 1 - opacity, and rendered images match
+// the closed-form value of a masked plane in a constant environment.
+#include "scene_builders.h"
+#include "test_support.h"
+#include "tessera/bsdf/mask.h"
+#include "tessera/core/hash.h"
+#include "tessera/image/image.h"
+#include "tessera/render/renderer.h"
+#include "tessera/scene/load_context.h"
+#include "tessera/texture/bitmap.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace tessera {
+namespace {
+
+using namespace tessera::test;
+
+std::shared_ptr<MeshData> quad_at_z(float z, float half) {
+  auto m = std::make_shared<MeshData>();
+  m->positions = {{-half, -half, z}, {half, -half, z}, {half, half, z}, {-half, half, z}};
+  m->indices = {0, 1, 2, 0, 2, 3};
+  return m;
+}
+
+const Bsdf* add_mask(Scene& scene, const Bsdf* nested, float opacity) {
+  auto b = make_mask_bsdf(nested, std::make_shared<ConstantTexture>(Rgb(opacity)), OpacitySource::Luminance);
+  scene.bsdfs.push_back(b);
+  return b.get();
+}
+
+void add_quad(Scene& scene, float z, float half, const Bsdf* bsdf) {
+  scene.shapes.push_back(std::make_unique<TriangleMeshShape>(quad_at_z(z, half), false, false));
+  scene.shapes.back()->bsdf = bsdf;
+}
+
+// Two masked quads (opacity 0.3 at z=1, 0.5 at z=2) in front of an opaque one at z=3.
+std::unique_ptr<Scene> stacked_quads() {
+  auto scene = std::make_unique<Scene>();
+  const Bsdf* diffuse = add_diffuse(*scene, Rgb(0.5f));
+  add_quad(*scene, 1.f, 10.f, add_mask(*scene, diffuse, 0.3f));
+  add_quad(*scene, 2.f, 10.f, add_mask(*scene, diffuse, 0.5f));
+  add_quad(*scene, 3.f, 10.f, diffuse);
+  scene->finalize();
+  return scene;
+}
+
+TEST(Mask, RaysStopAtEachLayerWithItsOpacity) {
+  auto scene = stacked_quads();
+  ASSERT_TRUE(scene->has_masks());
+  Pcg32 rng(7);
+  const int n = 30000;
+  int counts[3] = {0, 0, 0};
+  for (int i = 0; i < n; ++i) {
+    Ray r;
+    r.o = Vec3(rng.next_float() - 0.5f, rng.next_float() - 0.5f, 0.f);
+    r.d = normalize(Vec3(rng.next_float() - 0.5f, rng.next_float() - 0.5f, 1.f));
+    SurfaceInteraction si;
+    ASSERT_TRUE(scene->intersect(r, si));
+    int layer = int(std::lround(si.p.z)) - 1;
+    ASSERT_TRUE(layer >= 0 && layer < 3) << si.p.z;
+    // si.t is measured from the original origin even after passing through masks.
+    EXPECT_NEAR(si.t, (si.p.z - r.o.z) / r.d.z, 1e-4f * si.t);
+    ++counts[layer];
+  }
+  // Expected: 0.3, 0.7 * 0.5, 0.7 * 0.5. Chi-square with 2 degrees of freedom at 0.01: 9.21.
+  const double expected[3] = {0.3 * n, 0.35 * n, 0.35 * n};
+  double chi2 = 0;
+  for (int k = 0; k < 3; ++k) chi2 += (counts[k] - expected[k]) * (counts[k] - expected[k]) / expected[k];
+  EXPECT_LT(chi2, 9.21) << counts[0] << " " << counts[1] << " " << counts[2];
+}
+
+TEST(Mask, ShadowRaysAreAttenuatedByOneMinusOpacity) {
+  auto scene = stacked_quads();
+  Ray through_masks = spawn_ray_to(Vec3(0.f, 0.f, 0.f), Vec3(0.f, 0.f, 1.f), Vec3(0.3f, 0.1f, 2.5f));
+  EXPECT_NEAR(scene->transmittance(through_masks), 0.7f * 0.5f, 1e-6f);
+  Ray to_first = spawn_ray_to(Vec3(0.f), Vec3(0.f, 0.f, 1.f), Vec3(0.f, 0.2f, 1.5f));
+  EXPECT_NEAR(scene->transmittance(to_first), 0.7f, 1e-6f);
+  Ray past_opaque = spawn_ray_to(Vec3(0.f), Vec3(0.f, 0.f, 1.f), Vec3(0.f, 0.f, 4.f));
+  EXPECT_EQ(scene->transmittance(past_opaque), 0.f);
+  Ray away = spawn_ray(Vec3(0.f), Vec3(0.f, 0.f, 1.f), Vec3(0.f, 0.f, -1.f));
+  EXPECT_EQ(scene->transmittance(away), 1.f);
+  // Without masks the same calls are plain visibility.
+  Scene opaque;
+  add_quad(opaque, 1.f, 10.f, add_diffuse(opaque, Rgb(0.5f)));
+  opaque.finalize();
+  EXPECT_FALSE(opaque.has_masks());
+  EXPECT_EQ(opaque.transmittance(to_first), 0.f);
+}
+
+TEST(Mask, NanOpacityIsOpaqueAndValuesAreClamped) {
+  Scene scene;
+  const Bsdf* diffuse = add_diffuse(scene, Rgb(0.5f));
+  SurfaceInteraction si;
+  EXPECT_EQ(add_mask(scene, diffuse, std::nanf(""))->opacity(si), 1.f);
+  EXPECT_EQ(add_mask(scene, diffuse, 2.f)->opacity(si), 1.f);
+  EXPECT_EQ(add_mask(scene, diffuse, -1.f)->opacity(si), 0.f);
+  // The opaque part is the nested BSDF itself.
+  const Bsdf* m = add_mask(scene, diffuse, 0.25f);
+  Vec3 wo = normalize(Vec3(0.2f, 0.1f, 1.f)), wi = normalize(Vec3(-0.3f, 0.4f, 0.8f));
+  EXPECT_EQ(m->eval(si, wo, wi).g, diffuse->eval(si, wo, wi).g);
+  EXPECT_EQ(m->pdf(si, wo, wi), diffuse->pdf(si, wo, wi));
+}
+
+LoadResult load_06(const std::string& body) {
+  return load_scene(parse_scene_string("<scene version=\"0.6.0\">\n" + body + "\n</scene>\n", "mem/mask.xml"), {});
+}
+
+const char* kCamera = R"(
+  <sensor type="perspective"><float name="fov" value="20"/>
+    <transform name="toWorld"><lookat origin="0,0,5" target="0,0,0" up="0,1,0"/></transform>
+    <sampler type="independent"><integer name="sampleCount" value="64"/></sampler>
+    <film type="hdrfilm"><integer name="width" value="12"/><integer name="height" value="12"/>
+      <rfilter type="box"/></film>
+  </sensor>)";
+
+double mean_of(const Film& film) {
+  double sum = 0;
+  int n = 0;
+  for (int y = 0; y < film.height(); ++y)
+    for (int x = 0; x < film.width(); ++x, ++n) sum += film.mean({x, y}).average();
+  return sum / n;
+}
+
+// A plane of albedo rho and opacity a facing the camera, in a constant environment of radiance 1:
+// the plane's lit side reflects rho (irradiance pi from the open hemisphere), so a pixel sees
+// a * rho + (1 - a). 0.3 * 0.5 + 0.7 = 0.85; an unmasked plane would give 0.5, swapped opacity 0.65.
+TEST(Mask, MaskedPlaneInConstantEnvironmentMatchesClosedForm) {
+  LoadResult r = load_06(std::string("<integrator type=\"path\"/>") + kCamera + R"(
+    <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
+    <shape type="rectangle"><transform name="toWorld"><scale value="3"/></transform>
+      <bsdf type="mask"><float name="opacity" value="0.3"/>
+        <bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf></bsdf>
+    </shape>)");
+  ASSERT_TRUE(r.unsupported.empty());
+  RenderSettings s;
+  s.spp = 256;
+  s.seed = 3;
+  RenderStats stats;
+  Film film = render(*r.scene, s, {}, &stats);
+  // Per-sample standard deviation is at most ~0.5 (a Bernoulli choice between 0.5 and 1 plus the
+  // diffuse estimate); 144 pixels x 256 samples: standard error < 0.002.
+  EXPECT_NEAR(mean_of(film), 0.85, 0.006);
+  EXPECT_EQ(stats.counters.nonfinite, 0u);
+}
+
+// Direct light only, through a masked occluder behind the camera: every pixel of the floor gets
+// exactly (1 - opacity) of the light it gets with no occluder (same samples, a point light).
+TEST(Mask, ShadowOfMaskedOccluderScalesDirectLightExactly) {
+  auto floor_scene = [](const std::string& occluder) {
+    return load_06(R"(<integrator type="path"><integer name="maxDepth" value="2"/></integrator>
+      <sensor type="perspective"><float name="fov" value="60"/>
+        <transform name="toWorld"><lookat origin="0,0,0.5" target="0,0,0" up="0,1,0"/></transform>
+        <sampler type="independent"><integer name="sampleCount" value="4"/></sampler>
+        <film type="hdrfilm"><integer name="width" value="10"/><integer name="height" value="10"/>
+          <rfilter type="box"/></film>
+      </sensor>
+      <emitter type="point"><point name="position" x="0" y="0" z="2"/><rgb name="intensity" value="5"/></emitter>
+      <shape type="rectangle"><transform name="toWorld"><scale value="10"/></transform>
+        <bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf></shape>)" + occluder);
+  };
+  const std::string quad = R"(<shape type="rectangle"><transform name="toWorld"><scale value="0.5"/>
+      <translate z="1"/></transform>)";
+  LoadResult open = floor_scene("");
+  LoadResult masked = floor_scene(quad + R"(<bsdf type="mask"><float name="opacity" value="0.4"/>
+      <bsdf type="twosided"><bsdf type="diffuse"/></bsdf></bsdf></shape>)");
+  LoadResult opaque = floor_scene(quad + "<bsdf type=\"diffuse\"/></shape>");
+  RenderSettings s;
+  s.spp = 4;
+  Film f_open = render(*open.scene, s), f_masked = render(*masked.scene, s), f_opaque = render(*opaque.scene, s);
+  for (int y = 0; y < 10; ++y)
+    for (int x = 0; x < 10; ++x) {
+      float lit = f_open.mean({x, y}).g;
+      ASSERT_GT(lit, 0.f);
+      EXPECT_NEAR(f_masked.mean({x, y}).g / lit, 0.6f, 1e-5f) << x << "," << y;
+      EXPECT_EQ(f_opaque.mean({x, y}).g, 0.f);
+    }
+}
+
+// An RGBA bitmap as opacity uses its alpha: the living room's leaf.png is white where alpha is 0,
+// so its colour would make the cut-outs opaque white squares.
+TEST(Mask, RgbaBitmapOpacityIsItsAlphaChannel) {
+  const std::string leaf = shared_path("scenes/living-room/textures/leaf.png");
+  TESSERA_REQUIRE_FILE(leaf);
+  LoadResult r = load_06(R"(<shape type="rectangle"><bsdf type="mask">
+      <texture name="opacity" type="bitmap"><string name="filename" value=")" + leaf + R"("/></texture>
+      <bsdf type="diffuse"/></bsdf></shape>)");
+  ASSERT_TRUE(r.unsupported.empty());
+  const Bsdf* mask = r.scene->shapes.at(0)->bsdf;
+  ASSERT_TRUE(mask && mask->has_opacity());
+  Image img = read_image(leaf);
+  ASSERT_EQ(img.channels(), 4);
+  int seen_clear = 0, seen_solid = 0;
+  for (int y = 0; y < img.height(); y += 7)
+    for (int x = 0; x < img.width(); x += 7) {
+      float a = img.at(x, y, 3);
+      if (a != 0.f && a != 1.f) continue;
+      // Only texels whose neighbours agree, so the bilinear lookup at the centre is that value.
+      bool uniform = x > 0 && y > 0 && x + 1 < img.width() && y + 1 < img.height();
+      for (int dy = -1; uniform && dy <= 1; ++dy)
+        for (int dx = -1; uniform && dx <= 1; ++dx) uniform = img.at(x + dx, y + dy, 3) == a;
+      if (!uniform) continue;
+      SurfaceInteraction si;
+      si.uv = Vec2((x + 0.5f) / img.width(), (y + 0.5f) / img.height());
+      si.wo = si.shading.n;
+      EXPECT_NEAR(mask->opacity(si), a, 1e-6f) << x << "," << y;
+      (a == 0.f ? seen_clear : seen_solid)++;
+    }
+  EXPECT_GT(seen_clear, 50);
+  EXPECT_GT(seen_solid, 50);
+}
+
+}  // namespace
+}  // namespace tessera
