@@ -24,8 +24,8 @@ class DirectIntegrator final : public Integrator {
     const Vec3 wo_world = -ray.d;
     if (const Light* area = si.area_light(); area && !s_.hide_emitters) L += area->le(si, wo_world);
 
+    if (!reconcile_shading_frame(si, wo_world, s_.strict_normals)) return L;
     const Vec3 wo = si.to_local(wo_world);
-    if (s_.strict_normals && dot(si.ng, wo_world) * wo.z <= 0.f) return L;
     const Bsdf* bsdf = si.bsdf();
     if (!bsdf) return L;
 
@@ -42,7 +42,7 @@ class DirectIntegrator final : public Integrator {
       if (!light || !(pmf > 0.f) || !light->sample_li(si.p, u_light, ls)) continue;
       if (!(ls.pdf > 0.f) || ls.li.is_black()) continue;
       const Vec3 wi = si.to_local(ls.wi);
-      if (s_.strict_normals && dot(si.ng, ls.wi) * wi.z <= 0.f) continue;
+      if (!consistent_side(si, ls.wi, wi)) continue;
       Rgb f = bsdf->eval(si, wo, wi);
       if (f.is_black()) continue;
       Ray shadow = ls.dist < kInfinity ? spawn_ray_to(si.p, si.ng, ls.p_light) : spawn_ray(si.p, si.ng, ls.wi);
@@ -60,7 +60,7 @@ class DirectIntegrator final : public Integrator {
       BsdfSample bs;
       if (!bsdf->sample(si, wo, u_lobe, u_bsdf, bs)) continue;
       const Vec3 wi_world = si.to_world(bs.wi);
-      if (s_.strict_normals && dot(si.ng, wi_world) * bs.wi.z <= 0.f) continue;
+      if (!consistent_side(si, wi_world, bs.wi)) continue;
       Ray next = spawn_ray(si.p, si.ng, wi_world);
       ++counters.bounce_rays;
       SurfaceInteraction hit;

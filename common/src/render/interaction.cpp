@@ -8,6 +8,13 @@
 
 namespace tessera {
 
+bool reconcile_shading_frame(SurfaceInteraction& si, Vec3 wo_world, bool strict_normals) {
+  if (consistent_side(si, wo_world, si.to_local(wo_world))) return true;
+  if (strict_normals) return false;
+  si.shading = Frame(si.ng);
+  return true;
+}
+
 const Bsdf* SurfaceInteraction::bsdf() const { return shape ? shape->bsdf : nullptr; }
 const Light* SurfaceInteraction::area_light() const { return shape ? shape->light : nullptr; }
 

@@ -52,10 +52,8 @@ class PathIntegrator final : public Integrator {
       }
 
       if (s_.max_depth >= 0 && depth + 1 >= s_.max_depth) break;
+      if (!reconcile_shading_frame(si, wo_world, s_.strict_normals)) break;
       const Vec3 wo = si.to_local(wo_world);
-      // Shading and geometric normals must agree on which side the viewer is (Mitsuba 0.6's
-      // strictNormals), otherwise light leaks through interpolated normals.
-      if (s_.strict_normals && dot(si.ng, wo_world) * wo.z <= 0.f) break;
       const Bsdf* bsdf = si.bsdf();
       if (!bsdf) break;
 
@@ -71,7 +69,7 @@ class PathIntegrator final : public Integrator {
       BsdfSample bs;
       if (!bsdf->sample(si, wo, u_lobe, u_bsdf, bs)) break;
       const Vec3 wi_world = si.to_world(bs.wi);
-      if (s_.strict_normals && dot(si.ng, wi_world) * bs.wi.z <= 0.f) break;
+      if (!consistent_side(si, wi_world, bs.wi)) break;
       throughput *= bs.weight;
       prev_bsdf_pdf = bs.pdf;
       prev_delta = bs.delta;
@@ -103,7 +101,7 @@ class PathIntegrator final : public Integrator {
     if (!light || !(pmf > 0.f) || !light->sample_li(si.p, u_light, ls)) return {};
     if (!(ls.pdf > 0.f) || ls.li.is_black()) return {};
     const Vec3 wi = si.to_local(ls.wi);
-    if (s_.strict_normals && dot(si.ng, ls.wi) * wi.z <= 0.f) return {};
+    if (!consistent_side(si, ls.wi, wi)) return {};
     Rgb f = bsdf.eval(si, wo, wi);
     if (f.is_black()) return {};
     Ray shadow = ls.dist < kInfinity ? spawn_ray_to(si.p, si.ng, ls.p_light) : spawn_ray(si.p, si.ng, ls.wi);

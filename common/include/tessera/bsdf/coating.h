@@ -22,8 +22,8 @@ std::shared_ptr<Bsdf> make_coating_bsdf(float eta, float thickness, std::shared_
 /// Rough interface (isotropic alpha, constant or textured): microfacet reflection plus `nested`
 /// seen through the interface as if it were smooth, attenuated by the rough transmittance
 /// T(cos_o) T(cos_i) instead of the Fresnel factors (Mitsuba's approximation). The transmittance
-/// is tabulated at construction: for a constant alpha one table; otherwise tables over
-/// alpha in [1e-3, 1] (clamped beyond), which takes some 50 ms.
+/// is tabulated at construction: for a constant alpha one table (tens of ms); for a textured alpha
+/// tables at nine roughness values in [1e-3, 1] (clamped beyond), a few hundred ms.
 std::shared_ptr<Bsdf> make_roughcoating_bsdf(MicrofacetType type, std::shared_ptr<const Texture> alpha, float eta,
                                              float thickness, std::shared_ptr<const Texture> sigma_a,
                                              std::shared_ptr<const Texture> specular_reflectance,

@@ -35,6 +35,21 @@ struct SurfaceInteraction {
   Vec3 to_world(Vec3 w) const { return shading.to_world(w); }
 };
 
+/// Reconciles the interpolated shading normal with the geometry for a viewer in `wo_world`, as the
+/// integrators need at every vertex. When the viewer is on one side of the geometric surface and on
+/// the other of the shading one, Mitsuba 0.6 with `strictNormals` drops the vertex (returns false);
+/// otherwise Tessera shades that hit with the geometric normal instead, so such pixels are not black
+/// (the "black seams" of strongly interpolated or bumped normals).
+bool reconcile_shading_frame(SurfaceInteraction& si, Vec3 wo_world, bool strict_normals);
+
+/// True when direction `wi_world` (`wi_local` in the shading frame) is on the same side of the
+/// geometric and of the shading surface. Integrators drop light and BSDF samples that are not:
+/// light from behind the geometry would otherwise leak through a surface its shading normal tilts
+/// towards.
+inline bool consistent_side(const SurfaceInteraction& si, Vec3 wi_world, Vec3 wi_local) {
+  return dot(si.ng, wi_world) * wi_local.z > 0.f;
+}
+
 /// Wächter and Binder, "A Fast and Robust Method for Avoiding Self-Intersection" (Ray Tracing Gems,
 /// ch. 6): moves `p` off the surface along `n` by a few ULPs scaled to |p|, so a new ray starting
 /// there neither re-hits its own surface nor tunnels through a thin neighbour.
