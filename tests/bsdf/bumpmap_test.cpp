@@ -16,6 +16,7 @@ namespace tessera {
 namespace {
 
 using test::direction_deg;
+using test::expect_finite_everywhere;
 
 Vec3 tilted_normal(Vec2 grad, Vec3 dpdu, Vec3 dpdv) {
   // For orthogonal dp/du, dp/dv in the z = 0 plane: n ~ (-grad_u/|dpdu|, -grad_v/|dpdv|, 1) in
@@ -35,22 +36,7 @@ TEST(BumpMap, FlatMapIsExactlyTheNestedBsdf) {
   for (const auto& flat : flats) {
     for (const Bsdf* nested : {diffuse.get(), gold.get()}) {
       auto bump = make_bumpmap_bsdf(nested, flat);
-      Pcg32 rng(3);
-      for (int i = 0; i < 500; ++i) {
-        Vec3 wo = direction_deg(85.f * rng.next_float(), 360.f * rng.next_float());
-        Vec3 wi = direction_deg(85.f * rng.next_float(), 360.f * rng.next_float());
-        EXPECT_EQ(bump->eval(si, wo, wi), nested->eval(si, wo, wi));
-        EXPECT_EQ(bump->pdf(si, wo, wi), nested->pdf(si, wo, wi));
-        float u1 = rng.next_float();
-        Vec2 u2(rng.next_float(), rng.next_float());
-        BsdfSample a, b;
-        bool ok_a = bump->sample(si, wo, u1, u2, a), ok_b = nested->sample(si, wo, u1, u2, b);
-        ASSERT_EQ(ok_a, ok_b);
-        if (!ok_a) continue;
-        EXPECT_EQ(a.wi, b.wi);
-        EXPECT_EQ(a.pdf, b.pdf);
-        EXPECT_EQ(a.weight, b.weight);
-      }
+      ASSERT_NO_FATAL_FAILURE(test::expect_flat_map_is_nested(*bump, *nested, si, 3));
     }
   }
 }
@@ -107,59 +93,16 @@ TEST(BumpMap, RampTiltsTheNormalByTheAnalyticAngle) {
   }
 }
 
-const float kAngles[] = {0.f, 30.f, 60.f, 80.f};
-
+// The ramp's normal leans towards azimuth 207 degrees.
 TEST(BumpMap, Chi2SamplingMatchesPdfOverATiltedFrame) {
-  auto diffuse = test::white_diffuse(0.8f);
-  auto gold = test::rough_gold(0.3f);
   auto ramp = test::ramp_texture(0.5f, 0.25f);
-  SurfaceInteraction si = test::flat_si();
-  const int tests = 2 * int(std::size(kAngles));
-  for (const Bsdf* nested : {diffuse.get(), gold.get()}) {
-    auto bump = make_bumpmap_bsdf(nested, ramp);
-    for (float deg : kAngles) {
-      test::Chi2Options o;
-      o.test_count = tests;
-      o.sample_count = 300000;
-      o.name = std::string(nested == diffuse.get() ? "diffuse" : "roughconductor") + " theta_o " + std::to_string(deg);
-      if (nested == gold.get()) {
-        o.cos_theta_bins = 100;
-        o.phi_bins = 200;
-        o.sample_count = 1000000;
-      }
-      // Azimuth towards the tilt, so wo stays above the bumped normal even at 80 degrees.
-      auto r = test::bsdf_chi2_test(*bump, si, direction_deg(deg, 190.f), o);
-      EXPECT_TRUE(r.passed) << r.message;
-      EXPECT_GT(r.valid_samples, o.sample_count / 2) << o.name;
-    }
-  }
+  test::expect_tilted_chi2_passes([&](const Bsdf* nested) { return make_bumpmap_bsdf(nested, ramp); });
 }
 
 TEST(BumpMap, SampleWeightIsEvalOverPdf) {
   auto ramp = test::ramp_texture(0.5f, 0.25f);
-  SurfaceInteraction si = test::flat_si();
-  auto diffuse = test::white_diffuse(0.8f);
-  auto gold = test::rough_gold(0.3f);
-  for (const Bsdf* nested : {diffuse.get(), gold.get()}) {
-    auto bump = make_bumpmap_bsdf(nested, ramp);
-    Pcg32 rng(11);
-    int checked = 0;
-    for (float deg : kAngles) {
-      Vec3 wo = direction_deg(deg, 190.f);
-      for (int i = 0; i < 300; ++i) {
-        BsdfSample bs;
-        if (!bump->sample(si, wo, rng.next_float(), {rng.next_float(), rng.next_float()}, bs)) continue;
-        ASSERT_GT(bs.wi.z, 0.f);
-        float pdf = bump->pdf(si, wo, bs.wi);
-        ASSERT_GT(pdf, 0.f);
-        EXPECT_NEAR(bs.pdf, pdf, 1e-3f * pdf);
-        Rgb ratio = bump->eval(si, wo, bs.wi) / pdf;
-        for (int c = 0; c < 3; ++c) EXPECT_NEAR(bs.weight[c], ratio[c], 2e-3f * ratio[c] + 1e-6f);
-        ++checked;
-      }
-    }
-    EXPECT_GT(checked, 600);
-  }
+  test::expect_tilted_weights_are_eval_over_pdf([&](const Bsdf* nested) { return make_bumpmap_bsdf(nested, ramp); },
+                                                11);
 }
 
 // A cosine lobe about a normal tilted by alpha, clipped by the true horizon, keeps (1 + cos alpha)/2
@@ -169,13 +112,7 @@ TEST(BumpMap, WhiteDiffuseAlbedoIsTheClippedLobe) {
   auto diffuse = test::white_diffuse(1.f);
   auto bump = make_bumpmap_bsdf(diffuse.get(), test::ramp_texture(0.5f, 0.f));
   SurfaceInteraction si = test::flat_si();
-  const double expected = 0.5 * (1.0 + std::cos(std::atan(0.5)));
-  for (float deg : kAngles) {
-    double mean, err;
-    test::directional_albedo(*bump, si, direction_deg(deg, 180.f), 200000, 17, mean, err);
-    EXPECT_NEAR(mean, expected, 4 * err + 1e-3) << deg;
-    EXPECT_LE(mean, 1.0 + 4 * err);
-  }
+  test::expect_clipped_lobe_albedo(*bump, 180.f, 17, 0.5 * (1.0 + std::cos(std::atan(0.5))));
   // Seen from beyond the bumped horizon (wo above the surface, below the tilted normal).
   double mean, err;
   test::directional_albedo(*bump, si, direction_deg(80.f, 0.f), 20000, 17, mean, err);
@@ -202,22 +139,6 @@ TEST(BumpMap, ForwardsDeltaAndOpacity) {
   EXPECT_FALSE(plain->has_opacity());
 }
 
-void expect_finite_everywhere(const Bsdf& b, const SurfaceInteraction& si, const char* what) {
-  Pcg32 rng(23);
-  for (int i = 0; i < 300; ++i) {
-    Vec3 wo = direction_deg(180.f * rng.next_float(), 360.f * rng.next_float());
-    Vec3 wi = direction_deg(180.f * rng.next_float(), 360.f * rng.next_float());
-    ASSERT_TRUE(b.eval(si, wo, wi).is_finite()) << what;
-    float pdf = b.pdf(si, wo, wi);
-    ASSERT_TRUE(std::isfinite(pdf) && pdf >= 0.f) << what;
-    BsdfSample bs;
-    if (b.sample(si, wo, rng.next_float(), {rng.next_float(), rng.next_float()}, bs)) {
-      ASSERT_TRUE(is_finite(bs.wi) && std::isfinite(bs.pdf) && bs.weight.is_finite()) << what;
-      ASSERT_NEAR(length(bs.wi), 1.f, 1e-4f) << what;
-    }
-  }
-}
-
 std::shared_ptr<BitmapTexture> bad_texel_texture(float bad) {
   Image im(8, 8, 1);
   for (int y = 0; y < 8; ++y)
@@ -234,21 +155,21 @@ TEST(BumpMap, DegenerateInputsNeverGiveNaN) {
     auto ramp = make_bumpmap_bsdf(nested, test::ramp_texture(0.5f, 0.25f));
     SurfaceInteraction si = test::flat_si();
     si.dpdu = si.dpdv = Vec3(0.f);  // zero dp/du: the unperturbed frame stands in
-    expect_finite_everywhere(*ramp, si, "zero dpdu");
+    expect_finite_everywhere(*ramp, si, 23, 300, "zero dpdu");
     Vec3 wo = direction_deg(30.f, 10.f), wi = direction_deg(50.f, 200.f);
     EXPECT_EQ(ramp->eval(si, wo, wi), nested->eval(si, wo, wi));
     si.dpdu = si.dpdv = Vec3(1.f, 0.f, 0.f);  // collinear
-    expect_finite_everywhere(*ramp, si, "collinear dpdu dpdv");
+    expect_finite_everywhere(*ramp, si, 23, 300, "collinear dpdu dpdv");
     si.dpdu = Vec3(1e30f, 0.f, 0.f);  // overflowing cross product
     si.dpdv = Vec3(0.f, 1e30f, 0.f);
-    expect_finite_everywhere(*ramp, si, "huge dpdu");
+    expect_finite_everywhere(*ramp, si, 23, 300, "huge dpdu");
     si = test::flat_si({nan, 0.5f});
-    expect_finite_everywhere(*ramp, si, "NaN uv");
+    expect_finite_everywhere(*ramp, si, 23, 300, "NaN uv");
     for (float bad : {nan, inf, -inf, 1e38f}) {
       auto b = make_bumpmap_bsdf(nested, bad_texel_texture(bad));
       for (float u : {0.375f, 0.45f, 0.5f, 0.55f}) {
         SurfaceInteraction s = test::flat_si({u, 0.5625f});
-        expect_finite_everywhere(*b, s, "bad texel");
+        expect_finite_everywhere(*b, s, 23, 300, "bad texel");
       }
     }
   }

@@ -24,15 +24,11 @@
 namespace tessera {
 namespace {
 
-std::shared_ptr<Texture> constant(Rgb c) { return std::make_shared<ConstantTexture>(c); }
-std::shared_ptr<Texture> constant(float c) { return constant(Rgb(c)); }
-
-const Vec3 kWo[] = {Vec3(0.f, 0.f, 1.f), normalize(Vec3(0.6f, -0.3f, 0.5f)), normalize(Vec3(-0.9f, 0.1f, 0.15f)),
-                    normalize(Vec3(0.2f, 0.99f, 0.03f))};
-
-std::shared_ptr<Bsdf> rough_metal(const char* name, MicrofacetType type, float alpha) {
-  return make_roughconductor_bsdf(type, constant(alpha), nullptr, *lookup_metal(name), constant(1.f));
-}
+using test::albedo;
+using test::AlbedoEstimate;
+using test::constant;
+using test::kWo;
+using test::rough_metal;
 
 // Cosine of a direction of cosine c refracted into a layer of relative IOR eta (Snell).
 float cos_inside(float c, float eta) { return std::sqrt(1.f - (1.f - c * c) / (eta * eta)); }
@@ -43,26 +39,6 @@ float expected_p_spec(float cos_o, float eta, Rgb sigma_a, float thickness) {
                      std::exp(-2 * thickness * sigma_a.b)) / 3;
   const float w = 1 / (avg + 1), f = fresnel_dielectric(cos_o, eta);
   return f * w / (f * w + (1 - f) * (1 - w));
-}
-
-struct Estimate {
-  double mean = 0, se = 0;
-};
-// Mean green sample weight (directional albedo) and its standard error, fixed seed.
-Estimate albedo(const Bsdf& bsdf, Vec3 wo, int n = 100000) {
-  Pcg32 rng(17);
-  SurfaceInteraction si;
-  double sum = 0, sum2 = 0;
-  for (int i = 0; i < n; ++i) {
-    BsdfSample bs;
-    const float u1 = rng.next_float();
-    const Vec2 u2(rng.next_float(), rng.next_float());
-    if (!bsdf.sample(si, wo, u1, u2, bs)) continue;
-    sum += bs.weight.g;
-    sum2 += double(bs.weight.g) * bs.weight.g;
-  }
-  const double mean = sum / n;
-  return {mean, std::sqrt(std::max(sum2 / n - mean * mean, 0.0) / n)};
 }
 
 TEST(Coating, Chi2NestedLobeMatchesPdf) {
@@ -232,12 +208,12 @@ TEST(Coating, EnergyWithLosslessAndWhiteNested) {
     EXPECT_FALSE(on_rough->is_delta());
     for (Vec3 wo : kWo) {
       const float r = fresnel_dielectric(wo.z, eta);
-      const Estimate e = albedo(*on_mirror, wo);
+      const AlbedoEstimate e = albedo(*on_mirror, wo);
       EXPECT_NEAR(e.mean, r + (1 - r) * (1 - r), 4 * e.se + 1e-4) << eta << " " << wo.z;
-      const Estimate w = albedo(*on_white, wo);
+      const AlbedoEstimate w = albedo(*on_white, wo);
       EXPECT_NEAR(w.mean, r + (1 - r) * (1 - fresnel_diffuse_reflectance(1.f / eta)), 4 * w.se + 1e-3)
           << eta << " " << wo.z;
-      const Estimate a = albedo(*on_rough, wo);
+      const AlbedoEstimate a = albedo(*on_rough, wo);
       EXPECT_LE(a.mean, 1.0 + 4 * a.se + 1e-4) << eta << " " << wo.z;
       EXPECT_GT(a.mean, 0.3) << eta << " " << wo.z;  // ~0.43 at eta 2.2: much leaves beyond the critical angle
     }
@@ -272,33 +248,16 @@ TEST(Coating, BackSide) {
 TEST(Coating, FiniteAtGrazingAngles) {
   auto diffuse = make_diffuse_bsdf(constant(0.5f));
   auto metal = rough_metal("Cu", MicrofacetType::Ggx, 0.05f);
-  SurfaceInteraction si;
   Pcg32 rng(31);
   for (const Bsdf* nested : {static_cast<const Bsdf*>(diffuse.get()), static_cast<const Bsdf*>(metal.get())}) {
     for (float eta : {1.5f, 1.f / 1.5f}) {
       auto bsdf = make_coating_bsdf(eta, 2.f, constant(Rgb(0.f, 0.5f, 3.f)), constant(1.f), nested);
-      for (float z : {0.f, 1e-7f, 1e-4f, -1e-4f}) {
-        const Vec3 wo = normalize(Vec3(std::sqrt(1.f - z * z), 0.f, z));
-        for (int i = 0; i < 2000; ++i) {
-          BsdfSample bs;
-          if (bsdf->sample(si, wo, rng.next_float(), {rng.next_float(), rng.next_float()}, bs)) {
-            EXPECT_TRUE(bs.weight.is_finite() && std::isfinite(bs.pdf) && is_finite(bs.wi)) << z;
-          }
-          const Vec3 wi = test::direction_deg(89.99f + 0.01f * rng.next_float(), 360.f * rng.next_float());
-          EXPECT_TRUE(bsdf->eval(si, wo, wi).is_finite()) << z;
-          EXPECT_TRUE(bsdf->eval(si, wi, wo).is_finite()) << z;
-          EXPECT_TRUE(std::isfinite(bsdf->pdf(si, wo, wi))) << z;
-        }
-      }
+      test::expect_finite_at_grazing(*bsdf, rng);
     }
   }
 }
 
-LoadResult load_06(const std::string& body) {
-  LoadOptions options;
-  options.allow_unsupported = true;
-  return load_scene(parse_scene_string("<scene version=\"0.6.0\">\n" + body + "\n</scene>\n", "mem/coat.xml"), options);
-}
+LoadResult load_06(const std::string& body) { return test::load_mitsuba06(body, "mem/coat.xml"); }
 
 TEST(Coating, LoadsMitsuba06Xml) {
   auto r = load_06(R"(<shape type="sphere"><bsdf type="coating">

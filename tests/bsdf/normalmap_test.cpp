@@ -27,22 +27,7 @@ TEST(NormalMap, FlatMapIsExactlyTheNestedBsdf) {
   auto gold = test::rough_gold();
   for (const Bsdf* nested : {diffuse.get(), gold.get()}) {
     auto nm = make_normalmap_bsdf(nested, test::solid_rgb_texture(Rgb(0.5f, 0.5f, 1.f)));
-    Pcg32 rng(4);
-    for (int i = 0; i < 500; ++i) {
-      Vec3 wo = direction_deg(85.f * rng.next_float(), 360.f * rng.next_float());
-      Vec3 wi = direction_deg(85.f * rng.next_float(), 360.f * rng.next_float());
-      EXPECT_EQ(nm->eval(si, wo, wi), nested->eval(si, wo, wi));
-      EXPECT_EQ(nm->pdf(si, wo, wi), nested->pdf(si, wo, wi));
-      float u1 = rng.next_float();
-      Vec2 u2(rng.next_float(), rng.next_float());
-      BsdfSample a, b;
-      bool ok_a = nm->sample(si, wo, u1, u2, a), ok_b = nested->sample(si, wo, u1, u2, b);
-      ASSERT_EQ(ok_a, ok_b);
-      if (!ok_a) continue;
-      EXPECT_EQ(a.wi, b.wi);
-      EXPECT_EQ(a.pdf, b.pdf);
-      EXPECT_EQ(a.weight, b.weight);
-    }
+    ASSERT_NO_FATAL_FAILURE(test::expect_flat_map_is_nested(*nm, *nested, si, 4));
   }
 }
 
@@ -69,74 +54,25 @@ TEST(NormalMap, NormalIsReadInTheTangentSpace) {
   }
 }
 
-const float kAngles[] = {0.f, 30.f, 60.f, 80.f};
 // Tilted by 30 degrees towards azimuth 200 degrees.
 const Vec3 kTilted = direction_deg(30.f, 200.f);
 
 TEST(NormalMap, Chi2SamplingMatchesPdfOverATiltedFrame) {
-  auto diffuse = test::white_diffuse(0.8f);
-  auto gold = test::rough_gold(0.3f);
   auto normals = test::solid_rgb_texture(encode(kTilted));
-  SurfaceInteraction si = test::flat_si();
-  const int tests = 2 * int(std::size(kAngles));
-  for (const Bsdf* nested : {diffuse.get(), gold.get()}) {
-    auto nm = make_normalmap_bsdf(nested, normals);
-    for (float deg : kAngles) {
-      test::Chi2Options o;
-      o.test_count = tests;
-      o.sample_count = 300000;
-      o.name = std::string(nested == diffuse.get() ? "diffuse" : "roughconductor") + " theta_o " + std::to_string(deg);
-      if (nested == gold.get()) {
-        o.cos_theta_bins = 100;
-        o.phi_bins = 200;
-        o.sample_count = 1000000;
-      }
-      auto r = test::bsdf_chi2_test(*nm, si, direction_deg(deg, 190.f), o);
-      EXPECT_TRUE(r.passed) << r.message;
-      EXPECT_GT(r.valid_samples, o.sample_count / 2) << o.name;
-    }
-  }
+  test::expect_tilted_chi2_passes([&](const Bsdf* nested) { return make_normalmap_bsdf(nested, normals); });
 }
 
 TEST(NormalMap, SampleWeightIsEvalOverPdf) {
   auto normals = test::solid_rgb_texture(encode(kTilted));
-  SurfaceInteraction si = test::flat_si();
-  auto diffuse = test::white_diffuse(0.8f);
-  auto gold = test::rough_gold(0.3f);
-  for (const Bsdf* nested : {diffuse.get(), gold.get()}) {
-    auto nm = make_normalmap_bsdf(nested, normals);
-    Pcg32 rng(12);
-    int checked = 0;
-    for (float deg : kAngles) {
-      Vec3 wo = direction_deg(deg, 190.f);
-      for (int i = 0; i < 300; ++i) {
-        BsdfSample bs;
-        if (!nm->sample(si, wo, rng.next_float(), {rng.next_float(), rng.next_float()}, bs)) continue;
-        ASSERT_GT(bs.wi.z, 0.f);
-        float pdf = nm->pdf(si, wo, bs.wi);
-        ASSERT_GT(pdf, 0.f);
-        EXPECT_NEAR(bs.pdf, pdf, 1e-3f * pdf);
-        Rgb ratio = nm->eval(si, wo, bs.wi) / pdf;
-        for (int c = 0; c < 3; ++c) EXPECT_NEAR(bs.weight[c], ratio[c], 2e-3f * ratio[c] + 1e-6f);
-        ++checked;
-      }
-    }
-    EXPECT_GT(checked, 600);
-  }
+  test::expect_tilted_weights_are_eval_over_pdf(
+      [&](const Bsdf* nested) { return make_normalmap_bsdf(nested, normals); }, 12);
 }
 
 // As for bumpmap: a white diffuse about a normal tilted by alpha keeps (1 + cos alpha) / 2.
 TEST(NormalMap, WhiteDiffuseAlbedoIsTheClippedLobe) {
   auto diffuse = test::white_diffuse(1.f);
   auto nm = make_normalmap_bsdf(diffuse.get(), test::solid_rgb_texture(encode(kTilted)));
-  SurfaceInteraction si = test::flat_si();
-  const double expected = 0.5 * (1.0 + std::cos(30.0 * kPi / 180.0));
-  for (float deg : kAngles) {
-    double mean, err;
-    test::directional_albedo(*nm, si, direction_deg(deg, 200.f), 200000, 19, mean, err);
-    EXPECT_NEAR(mean, expected, 4 * err + 1e-3) << deg;
-    EXPECT_LE(mean, 1.0 + 4 * err);
-  }
+  test::expect_clipped_lobe_albedo(*nm, 200.f, 19, 0.5 * (1.0 + std::cos(30.0 * kPi / 180.0)));
 }
 
 TEST(NormalMap, BadTexelsAndTangentsNeverGiveNaN) {
@@ -151,19 +87,7 @@ TEST(NormalMap, BadTexelsAndTangentsNeverGiveNaN) {
       for (Vec3 dpdu : {Vec3(0.f), Vec3(0.f, 0.f, 1.f), Vec3(nan, 0.f, 0.f), Vec3(1e30f, 1e30f, 0.f)}) {
         SurfaceInteraction si = test::flat_si();
         si.dpdu = dpdu;
-        Pcg32 rng(29);
-        for (int i = 0; i < 200; ++i) {
-          Vec3 wo = direction_deg(180.f * rng.next_float(), 360.f * rng.next_float());
-          Vec3 wi = direction_deg(180.f * rng.next_float(), 360.f * rng.next_float());
-          ASSERT_TRUE(nm->eval(si, wo, wi).is_finite());
-          float pdf = nm->pdf(si, wo, wi);
-          ASSERT_TRUE(std::isfinite(pdf) && pdf >= 0.f);
-          BsdfSample bs;
-          if (nm->sample(si, wo, rng.next_float(), {rng.next_float(), rng.next_float()}, bs)) {
-            ASSERT_TRUE(is_finite(bs.wi) && bs.weight.is_finite() && std::isfinite(bs.pdf));
-            ASSERT_NEAR(length(bs.wi), 1.f, 1e-4f);
-          }
-        }
+        ASSERT_NO_FATAL_FAILURE(test::expect_finite_everywhere(*nm, si, 29, 200, "bad texel or tangent"));
       }
     }
     // A zero normal (grey texel) falls back to the shape's frame.

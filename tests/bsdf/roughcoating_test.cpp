@@ -21,15 +21,11 @@
 namespace tessera {
 namespace {
 
-std::shared_ptr<Texture> constant(Rgb c) { return std::make_shared<ConstantTexture>(c); }
-std::shared_ptr<Texture> constant(float c) { return constant(Rgb(c)); }
-
-const Vec3 kWo[] = {Vec3(0.f, 0.f, 1.f), normalize(Vec3(0.6f, -0.3f, 0.5f)), normalize(Vec3(-0.9f, 0.1f, 0.15f)),
-                    normalize(Vec3(0.2f, 0.99f, 0.03f))};
-
-std::shared_ptr<Bsdf> rough_metal(const char* name, MicrofacetType type, float alpha) {
-  return make_roughconductor_bsdf(type, constant(alpha), nullptr, *lookup_metal(name), constant(1.f));
-}
+using test::albedo;
+using test::AlbedoEstimate;
+using test::constant;
+using test::kWo;
+using test::rough_metal;
 
 float cos_inside(float c, float eta) { return std::sqrt(1.f - (1.f - c * c) / (eta * eta)); }
 
@@ -43,25 +39,6 @@ class UniformTexture final : public Texture {
  private:
   float v_;
 };
-
-struct Estimate {
-  double mean = 0, se = 0;
-};
-Estimate albedo(const Bsdf& bsdf, Vec3 wo, int n = 100000) {
-  Pcg32 rng(17);
-  SurfaceInteraction si;
-  double sum = 0, sum2 = 0;
-  for (int i = 0; i < n; ++i) {
-    BsdfSample bs;
-    const float u1 = rng.next_float();
-    const Vec2 u2(rng.next_float(), rng.next_float());
-    if (!bsdf.sample(si, wo, u1, u2, bs)) continue;
-    sum += bs.weight.g;
-    sum2 += double(bs.weight.g) * bs.weight.g;
-  }
-  const double mean = sum / n;
-  return {mean, std::sqrt(std::max(sum2 / n - mean * mean, 0.0) / n)};
-}
 
 TEST(RoughCoating, Chi2SampleMatchesPdf) {
   struct Case {
@@ -78,22 +55,12 @@ TEST(RoughCoating, Chi2SampleMatchesPdf) {
       {MicrofacetType::Ggx, 1.f, 1.5f, rough_metal("Au", MicrofacetType::Ggx, 0.5f), Rgb(0.3f)},
       {MicrofacetType::Phong, 0.3f, 1.5f, make_diffuse_bsdf(constant(0.5f)), Rgb(0.f)},
   };
-  test::Chi2Options o;
-  o.test_count = int(cases.size() * std::size(kWo));
-  o.name = "roughcoating";
-  o.sample_count = 200000;
+  const int test_count = int(cases.size() * std::size(kWo));
   for (const Case& c : cases) {
     auto bsdf = make_roughcoating_bsdf(c.type, constant(c.alpha), c.eta, 1.f, constant(c.sigma_a), constant(1.f),
                                        c.nested.get());
     for (Vec3 wo : kWo) {
-      test::Chi2Options oc = o;
-      if (c.alpha < 0.1f || wo.z < 0.2f) {
-        oc.cos_theta_bins = 200;
-        oc.phi_bins = 400;
-        oc.sample_count = 600000;
-      }
-      SurfaceInteraction si;
-      auto r = test::bsdf_chi2_test(*bsdf, si, wo, oc);
+      auto r = test::lobe_chi2_test(*bsdf, wo, c.alpha, test_count, "roughcoating");
       EXPECT_TRUE(r.passed) << "type " << int(c.type) << " alpha " << c.alpha << " eta " << c.eta << " wo.z "
                             << wo.z << "\n" << r.message;
     }
@@ -105,20 +72,8 @@ TEST(RoughCoating, WeightIsEvalOverPdf) {
   auto bsdf = make_roughcoating_bsdf(MicrofacetType::Ggx, constant(0.2f), 1.5f, 1.f, constant(Rgb(0.1f, 0.2f, 0.3f)),
                                      constant(0.9f), nested.get());
   EXPECT_FALSE(bsdf->is_delta());
-  Pcg32 rng(3);
-  SurfaceInteraction si;
   int ok = 0;
-  for (int i = 0; i < 4000; ++i) {
-    const Vec3 wo = kWo[i % 4];
-    BsdfSample bs;
-    if (!bsdf->sample(si, wo, rng.next_float(), {rng.next_float(), rng.next_float()}, bs)) continue;
-    ++ok;
-    ASSERT_FALSE(bs.delta);
-    const float pdf = bsdf->pdf(si, wo, bs.wi);
-    const Rgb f = bsdf->eval(si, wo, bs.wi);
-    EXPECT_NEAR(bs.pdf, pdf, 1e-4f * pdf);
-    for (int c = 0; c < 3; ++c) EXPECT_NEAR(bs.weight[c], f[c] / pdf, 1e-4f * f[c] / pdf + 1e-7f);
-  }
+  ASSERT_NO_FATAL_FAILURE(test::expect_weight_is_eval_over_pdf(*bsdf, ok));
   EXPECT_GT(ok, 2000);  // from grazing incidence many reflections end below the horizon
 }
 
@@ -148,7 +103,7 @@ TEST(RoughCoating, LambertianUnderCoatClosedFormAndSmoothLimit) {
     }
   }
   for (int i = 0; i < 3; ++i) {
-    const Estimate a = albedo(*smoothish, kWo[i]), b = albedo(*smooth, kWo[i]);
+    const AlbedoEstimate a = albedo(*smoothish, kWo[i]), b = albedo(*smooth, kWo[i]);
     EXPECT_NEAR(a.mean, b.mean, 4 * (a.se + b.se) + 5e-3) << kWo[i].z;
   }
 }
@@ -207,7 +162,7 @@ TEST(RoughCoating, WhiteFurnace) {
                                  static_cast<const Bsdf*>(mirror.get())}) {
         auto bsdf = make_roughcoating_bsdf(type, constant(alpha), 1.5f, 1.f, constant(0.f), constant(1.f), nested);
         for (Vec3 wo : kWo) {
-          const Estimate a = albedo(*bsdf, wo);
+          const AlbedoEstimate a = albedo(*bsdf, wo);
           EXPECT_LE(a.mean, 1.0 + 4 * a.se + 1e-3) << int(type) << " " << alpha << " " << wo.z;
           EXPECT_GT(a.mean, 0.1) << int(type) << " " << alpha << " " << wo.z;  // GGX alpha 1 at grazing: ~0.13
         }
@@ -231,34 +186,17 @@ TEST(RoughCoating, WhiteFurnace) {
 TEST(RoughCoating, FiniteAtGrazingAngles) {
   auto diffuse = make_diffuse_bsdf(constant(0.5f));
   auto metal = rough_metal("Cu", MicrofacetType::Ggx, 0.05f);
-  SurfaceInteraction si;
   Pcg32 rng(31);
   for (const Bsdf* nested : {static_cast<const Bsdf*>(diffuse.get()), static_cast<const Bsdf*>(metal.get())}) {
     for (MicrofacetType type : {MicrofacetType::Beckmann, MicrofacetType::Ggx, MicrofacetType::Phong}) {
       auto bsdf = make_roughcoating_bsdf(type, constant(0.05f), 1.5f, 2.f, constant(Rgb(0.f, 0.5f, 3.f)),
                                          constant(1.f), nested);
-      for (float z : {0.f, 1e-7f, 1e-4f, -1e-4f}) {
-        const Vec3 wo = normalize(Vec3(std::sqrt(1.f - z * z), 0.f, z));
-        for (int i = 0; i < 2000; ++i) {
-          BsdfSample bs;
-          if (bsdf->sample(si, wo, rng.next_float(), {rng.next_float(), rng.next_float()}, bs)) {
-            EXPECT_TRUE(bs.weight.is_finite() && std::isfinite(bs.pdf) && is_finite(bs.wi)) << z;
-          }
-          const Vec3 wi = test::direction_deg(89.99f + 0.01f * rng.next_float(), 360.f * rng.next_float());
-          EXPECT_TRUE(bsdf->eval(si, wo, wi).is_finite()) << z;
-          EXPECT_TRUE(bsdf->eval(si, wi, wo).is_finite()) << z;
-          EXPECT_TRUE(std::isfinite(bsdf->pdf(si, wo, wi))) << z;
-        }
-      }
+      test::expect_finite_at_grazing(*bsdf, rng);
     }
   }
 }
 
-LoadResult load_06(const std::string& body) {
-  LoadOptions options;
-  options.allow_unsupported = true;
-  return load_scene(parse_scene_string("<scene version=\"0.6.0\">\n" + body + "\n</scene>\n", "mem/rc.xml"), options);
-}
+LoadResult load_06(const std::string& body) { return test::load_mitsuba06(body, "mem/rc.xml"); }
 
 TEST(RoughCoating, LoadsMitsuba06Xml) {
   auto r = load_06(R"(<shape type="sphere"><bsdf type="roughcoating">

@@ -10,34 +10,10 @@
 namespace tessera {
 namespace {
 
-class BumpMapBsdf final : public Bsdf {
- public:
-  BumpMapBsdf(const Bsdf* nested, std::shared_ptr<const Texture> height)
-      : nested_(nested), height_(std::move(height)) {
-    TESSERA_CHECK(nested_ != nullptr && height_ != nullptr);
-  }
-
-  Rgb eval(const SurfaceInteraction& si, Vec3 wo, Vec3 wi) const override {
-    return query(si).eval(*nested_, wo, wi);
-  }
-  float pdf(const SurfaceInteraction& si, Vec3 wo, Vec3 wi) const override {
-    return query(si).pdf(*nested_, wo, wi);
-  }
-  bool sample(const SurfaceInteraction& si, Vec3 wo, float u1, Vec2 u2, BsdfSample& out) const override {
-    return query(si).sample(*nested_, wo, u1, u2, out);
-  }
-
-  bool is_delta() const override { return nested_->is_delta(); }
-  bool has_opacity() const override { return nested_->has_opacity(); }
-  float opacity(const SurfaceInteraction& si) const override { return nested_->opacity(si); }
-
- private:
-  PerturbedQuery query(const SurfaceInteraction& si) const {
-    return PerturbedQuery(si, bumped_frame(si, height_->eval_1_gradient(si)));
-  }
-
-  const Bsdf* nested_;
-  std::shared_ptr<const Texture> height_;
+/// Shared ownership: the loader's texture cache may hand the same height map to other BSDFs.
+struct BumpFrame {
+  std::shared_ptr<const Texture> height;
+  Frame operator()(const SurfaceInteraction& si) const { return bumped_frame(si, height->eval_1_gradient(si)); }
 };
 
 /// The i-th child of `node` as a texture. Through ctx.texture when its name finds it (shared
@@ -57,7 +33,8 @@ std::shared_ptr<Texture> nested_texture(const SceneNode& node, size_t i, LoadCon
 }  // namespace
 
 std::shared_ptr<Bsdf> make_bumpmap_bsdf(const Bsdf* nested, std::shared_ptr<const Texture> height) {
-  return std::make_shared<BumpMapBsdf>(nested, std::move(height));
+  TESSERA_CHECK(nested != nullptr && height != nullptr);
+  return std::make_shared<PerturbedBsdf<BumpFrame>>(nested, BumpFrame{std::move(height)});
 }
 
 std::shared_ptr<Bsdf> make_bumpmap(const SceneNode& node, LoadContext& ctx) {

@@ -13,42 +13,21 @@
 namespace tessera {
 namespace {
 
-class NormalMapBsdf final : public Bsdf {
- public:
-  NormalMapBsdf(const Bsdf* nested, std::shared_ptr<const Texture> normals)
-      : nested_(nested), normals_(std::move(normals)) {
-    TESSERA_CHECK(nested_ != nullptr && normals_ != nullptr);
-  }
-
-  Rgb eval(const SurfaceInteraction& si, Vec3 wo, Vec3 wi) const override {
-    return query(si).eval(*nested_, wo, wi);
-  }
-  float pdf(const SurfaceInteraction& si, Vec3 wo, Vec3 wi) const override {
-    return query(si).pdf(*nested_, wo, wi);
-  }
-  bool sample(const SurfaceInteraction& si, Vec3 wo, float u1, Vec2 u2, BsdfSample& out) const override {
-    return query(si).sample(*nested_, wo, u1, u2, out);
-  }
-
-  bool is_delta() const override { return nested_->is_delta(); }
-  bool has_opacity() const override { return nested_->has_opacity(); }
-  float opacity(const SurfaceInteraction& si) const override { return nested_->opacity(si); }
-
- private:
-  PerturbedQuery query(const SurfaceInteraction& si) const {
-    Rgb c = normals_->eval(si);
+/// Normals are stored as 2 rgb - 1 so that an ordinary [0, 1] image can hold them (Mitsuba 3).
+struct NormalMapFrame {
+  std::shared_ptr<const Texture> normals;
+  Frame operator()(const SurfaceInteraction& si) const {
+    Rgb c = normals->eval(si);
     Vec3 n(2.f * c.r - 1.f, 2.f * c.g - 1.f, 2.f * c.b - 1.f);
-    return PerturbedQuery(si, normal_mapped_frame(si, n));
+    return normal_mapped_frame(si, n);
   }
-
-  const Bsdf* nested_;
-  std::shared_ptr<const Texture> normals_;
 };
 
 }  // namespace
 
 std::shared_ptr<Bsdf> make_normalmap_bsdf(const Bsdf* nested, std::shared_ptr<const Texture> normals) {
-  return std::make_shared<NormalMapBsdf>(nested, std::move(normals));
+  TESSERA_CHECK(nested != nullptr && normals != nullptr);
+  return std::make_shared<PerturbedBsdf<NormalMapFrame>>(nested, NormalMapFrame{std::move(normals)});
 }
 
 std::shared_ptr<Bsdf> make_normalmap(const SceneNode& node, LoadContext& ctx) {

@@ -10,8 +10,11 @@
 // means.
 #pragma once
 
+#include "tessera/core/check.h"
 #include "tessera/core/frame.h"
 #include "tessera/render/bsdf.h"
+
+#include <utility>
 
 namespace tessera {
 
@@ -54,6 +57,38 @@ class PerturbedQuery {
   const SurfaceInteraction& si_;
   SurfaceInteraction perturbed_;
   bool same_ = false;
+};
+
+/// `nested` evaluated in the frame that `FrameFn` (a callable `Frame(const SurfaceInteraction&)
+/// const`) gives at each point: bumpmap and normalmap differ only in where that frame comes from.
+/// A template rather than a virtual frame hook, so the frame computation inlines into the hot path.
+/// Delta-ness and opacity are the nested BSDF's: tilting the frame changes neither.
+template <class FrameFn>
+class PerturbedBsdf final : public Bsdf {
+ public:
+  PerturbedBsdf(const Bsdf* nested, FrameFn frame) : nested_(nested), frame_(std::move(frame)) {
+    TESSERA_CHECK(nested_ != nullptr);
+  }
+
+  Rgb eval(const SurfaceInteraction& si, Vec3 wo, Vec3 wi) const override {
+    return query(si).eval(*nested_, wo, wi);
+  }
+  float pdf(const SurfaceInteraction& si, Vec3 wo, Vec3 wi) const override {
+    return query(si).pdf(*nested_, wo, wi);
+  }
+  bool sample(const SurfaceInteraction& si, Vec3 wo, float u1, Vec2 u2, BsdfSample& out) const override {
+    return query(si).sample(*nested_, wo, u1, u2, out);
+  }
+
+  bool is_delta() const override { return nested_->is_delta(); }
+  bool has_opacity() const override { return nested_->has_opacity(); }
+  float opacity(const SurfaceInteraction& si) const override { return nested_->opacity(si); }
+
+ private:
+  PerturbedQuery query(const SurfaceInteraction& si) const { return PerturbedQuery(si, frame_(si)); }
+
+  const Bsdf* nested_;
+  FrameFn frame_;
 };
 
 }  // namespace tessera

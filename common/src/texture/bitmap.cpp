@@ -152,6 +152,17 @@ Image decode_bitmap_values(const Image& stored, float gamma, bool raw) {
   return out;
 }
 
+Image extract_channel(const Image& image, int channel) {
+  const int c = image.channels() == 1 && channel < 3 ? 0 : channel;
+  if (c >= image.channels())
+    throw SceneError("has no channel '" + std::string(1, "rgba"[channel]) + "' (" +
+                     std::to_string(image.channels()) + " channel(s))");
+  Image out(image.width(), image.height(), 1);
+  for (int y = 0; y < image.height(); ++y)
+    for (int x = 0; x < image.width(); ++x) out.at(x, y, 0) = image.at(x, y, c);
+  return out;
+}
+
 namespace {
 
 WrapMode read_wrap_mode(const SceneNode& node, const std::string& name, const std::string& def) {
@@ -207,12 +218,23 @@ std::shared_ptr<Texture> make_bitmap(const SceneNode& node, LoadContext& ctx) {
   TextureFilter filter = read_filter(node);
   UvMapping to_uv(node.get_transform("to_uv", Transform()));
 
-  std::string key = path + "|gamma=" + std::to_string(gamma) + "|raw=" + (raw ? "1" : "0");
+  // Mitsuba 0.6's `channel`: one channel of the image as a monochrome texture (how a scene takes
+  // a mask from an alpha channel; without it, an RGBA image is its RGB, as in Mitsuba).
+  std::string channel = node.get_string("channel", "");
+  std::transform(channel.begin(), channel.end(), channel.begin(), [](unsigned char ch) { return char(std::tolower(ch)); });
+  const int channel_index = channel.empty() ? -1 : channel == "r" ? 0 : channel == "g" ? 1 : channel == "b" ? 2
+                                                                   : channel == "a" ? 3 : -2;
+  if (channel_index == -2)
+    throw SceneError(node.find("channel")->loc, node.describe() + ": unknown channel '" + channel + "' (r, g, b, a)");
+
+  std::string key = path + "|gamma=" + std::to_string(gamma) + "|raw=" + (raw ? "1" : "0") + "|channel=" + channel;
   std::shared_ptr<const Image> image = ctx.cached_image(key, [&] {
     try {
       Image stored = read_image(path);
       if (stored.empty()) throw SceneError("image has no pixels");
-      return decode_bitmap_values(stored, gamma, raw);
+      Image decoded = decode_bitmap_values(stored, gamma, raw);
+      if (channel_index >= 0) return extract_channel(decoded, channel_index);
+      return decoded;
     } catch (const SceneError& e) {
       // The reader names the file; the scene location says which texture wanted it.
       throw SceneError(file->loc, node.describe() + ": " + e.what());

@@ -85,5 +85,8 @@ class BitmapTexture final : public Texture {
 /// 8-bit files, linear for float files, unless `raw`), -1 = sRGB curve, g > 0 = v^g. Alpha is
 /// never decoded.
 Image decode_bitmap_values(const Image& stored, float gamma, bool raw);
+/// Channel `channel` (0..3 = r, g, b, a) of `image` as a one-channel image; a one-channel image
+/// serves r, g and b. Throws SceneError (without a location) when the image lacks the channel.
+Image extract_channel(const Image& image, int channel);
 
 }  // namespace tessera
