@@ -48,6 +48,30 @@ inline std::shared_ptr<Bsdf> rough_metal(const char* name, MicrofacetType type, 
   return make_roughconductor_bsdf(type, constant(alpha), nullptr, *lookup_metal(name), constant(1.f));
 }
 
+/// Layered BSDFs: the cosine of a direction of cosine `c` refracted into a layer of relative IOR
+/// `eta` (Snell).
+inline float cos_inside(float c, float eta) { return std::sqrt(1.f - (1.f - c * c) / (eta * eta)); }
+
+/// Layered BSDFs: absorption (`sigma_a` over thickness `d`, under an interface of relative IOR
+/// `eta`) scales `clear`'s value by exp(-sigma_a d (1/cos_o' + 1/cos_i')) per channel, cos' the
+/// refracted cosines. `also_clear`, when not null, must give `clear`'s value exactly.
+inline void expect_absorption_along_refracted(const Bsdf& clear, const Bsdf& tinted, const Bsdf* also_clear,
+                                              float eta, float d, Rgb sigma_a) {
+  SurfaceInteraction si;
+  for (Vec3 wo : kWo) {
+    for (float theta : {0.f, 40.f, 80.f}) {
+      const Vec3 wi = direction_deg(theta, 170.f);
+      const Rgb a = clear.eval(si, wo, wi), b = tinted.eval(si, wo, wi);
+      ASSERT_GT(a.g, 0.f);
+      const float len = d * (1 / cos_inside(wo.z, eta) + 1 / cos_inside(wi.z, eta));
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(b[c] / a[c], std::exp(-sigma_a[c] * len), 1e-4f) << wo.z << " " << theta;
+      if (also_clear) {
+        EXPECT_EQ(also_clear->eval(si, wo, wi), a);
+      }
+    }
+  }
+}
+
 /// `body` inside a Mitsuba 0.6 <scene>, loaded as if read from `virtual_path` (which error messages
 /// name); unsupported parameters are listed rather than fatal, so tests can assert the list empty.
 inline LoadResult load_mitsuba06(const std::string& body, const std::string& virtual_path) {

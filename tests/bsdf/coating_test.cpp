@@ -24,14 +24,8 @@
 namespace tessera {
 namespace {
 
-using test::albedo;
-using test::AlbedoEstimate;
 using test::constant;
 using test::kWo;
-using test::rough_metal;
-
-// Cosine of a direction of cosine c refracted into a layer of relative IOR eta (Snell).
-float cos_inside(float c, float eta) { return std::sqrt(1.f - (1.f - c * c) / (eta * eta)); }
 
 // Mitsuba's probability of the delta reflection.
 float expected_p_spec(float cos_o, float eta, Rgb sigma_a, float thickness) {
@@ -49,8 +43,8 @@ TEST(Coating, Chi2NestedLobeMatchesPdf) {
   };
   std::vector<Case> cases = {{make_diffuse_bsdf(constant(0.5f)), 1.5f, 1.f, Rgb(0.f)}};
   for (float alpha : {0.05f, 0.3f, 1.f}) {
-    cases.push_back({rough_metal("Cu", MicrofacetType::Beckmann, alpha), 1.33f, alpha, Rgb(0.f)});
-    cases.push_back({rough_metal("Au", MicrofacetType::Ggx, alpha), 2.f, alpha, Rgb(0.2f, 0.5f, 1.f)});
+    cases.push_back({test::rough_metal("Cu", MicrofacetType::Beckmann, alpha), 1.33f, alpha, Rgb(0.f)});
+    cases.push_back({test::rough_metal("Au", MicrofacetType::Ggx, alpha), 2.f, alpha, Rgb(0.2f, 0.5f, 1.f)});
   }
   cases.push_back({make_roughplastic_bsdf(MicrofacetType::Phong, 0.2f, 1.49f, constant(0.5f), constant(1.f), false),
                    1.7f, 0.2f, Rgb(0.3f)});
@@ -149,21 +143,11 @@ TEST(Coating, LambertianUnderCoatClosedForm) {
 TEST(Coating, AbsorptionAlongRefractedDirections) {
   const float eta = 1.4f, d = 0.7f;
   const Rgb sigma(0.1f, 0.5f, 2.f);
-  auto nested = rough_metal("Ag", MicrofacetType::Ggx, 0.5f);
+  auto nested = test::rough_metal("Ag", MicrofacetType::Ggx, 0.5f);
   auto clear = make_coating_bsdf(eta, d, constant(0.f), constant(1.f), nested.get());
   auto tinted = make_coating_bsdf(eta, d, constant(sigma), constant(1.f), nested.get());
   auto zero_thickness = make_coating_bsdf(eta, 0.f, constant(sigma), constant(1.f), nested.get());
-  SurfaceInteraction si;
-  for (Vec3 wo : kWo) {
-    for (float theta : {0.f, 40.f, 80.f}) {
-      const Vec3 wi = test::direction_deg(theta, 170.f);
-      const Rgb a = clear->eval(si, wo, wi), b = tinted->eval(si, wo, wi);
-      ASSERT_GT(a.g, 0.f);
-      const float len = d * (1 / cos_inside(wo.z, eta) + 1 / cos_inside(wi.z, eta));
-      for (int c = 0; c < 3; ++c) EXPECT_NEAR(b[c] / a[c], std::exp(-sigma[c] * len), 1e-4f) << wo.z << " " << theta;
-      EXPECT_EQ(zero_thickness->eval(si, wo, wi), a);
-    }
-  }
+  test::expect_absorption_along_refracted(*clear, *tinted, zero_thickness.get(), eta, d, sigma);
 }
 
 // int_ior == ext_ior and no absorption: the interface disappears, leaving the nested BSDF exactly.
@@ -198,7 +182,7 @@ TEST(Coating, InvisibleInterfaceIsTheNestedBsdf) {
 //  - a lossless rough mirror: at most 1.
 TEST(Coating, EnergyWithLosslessAndWhiteNested) {
   auto mirror = make_conductor_bsdf(*lookup_metal("none"), constant(1.f));
-  auto rough_mirror = rough_metal("none", MicrofacetType::Beckmann, 0.3f);
+  auto rough_mirror = test::rough_metal("none", MicrofacetType::Beckmann, 0.3f);
   auto white = make_diffuse_bsdf(constant(1.f));
   for (float eta : {1.33f, 1.5f, 2.2f}) {
     auto on_mirror = make_coating_bsdf(eta, 1.f, constant(0.f), constant(1.f), mirror.get());
@@ -208,12 +192,12 @@ TEST(Coating, EnergyWithLosslessAndWhiteNested) {
     EXPECT_FALSE(on_rough->is_delta());
     for (Vec3 wo : kWo) {
       const float r = fresnel_dielectric(wo.z, eta);
-      const AlbedoEstimate e = albedo(*on_mirror, wo);
+      const test::AlbedoEstimate e = test::albedo(*on_mirror, wo);
       EXPECT_NEAR(e.mean, r + (1 - r) * (1 - r), 4 * e.se + 1e-4) << eta << " " << wo.z;
-      const AlbedoEstimate w = albedo(*on_white, wo);
+      const test::AlbedoEstimate w = test::albedo(*on_white, wo);
       EXPECT_NEAR(w.mean, r + (1 - r) * (1 - fresnel_diffuse_reflectance(1.f / eta)), 4 * w.se + 1e-3)
           << eta << " " << wo.z;
-      const AlbedoEstimate a = albedo(*on_rough, wo);
+      const test::AlbedoEstimate a = test::albedo(*on_rough, wo);
       EXPECT_LE(a.mean, 1.0 + 4 * a.se + 1e-4) << eta << " " << wo.z;
       EXPECT_GT(a.mean, 0.3) << eta << " " << wo.z;  // ~0.43 at eta 2.2: much leaves beyond the critical angle
     }
@@ -247,7 +231,7 @@ TEST(Coating, BackSide) {
 
 TEST(Coating, FiniteAtGrazingAngles) {
   auto diffuse = make_diffuse_bsdf(constant(0.5f));
-  auto metal = rough_metal("Cu", MicrofacetType::Ggx, 0.05f);
+  auto metal = test::rough_metal("Cu", MicrofacetType::Ggx, 0.05f);
   Pcg32 rng(31);
   for (const Bsdf* nested : {static_cast<const Bsdf*>(diffuse.get()), static_cast<const Bsdf*>(metal.get())}) {
     for (float eta : {1.5f, 1.f / 1.5f}) {
@@ -270,7 +254,7 @@ TEST(Coating, LoadsMitsuba06Xml) {
   const Bsdf& loaded = *r.scene->shapes.at(0)->bsdf;
   const float eta = 1.5046f;
   const Vec3 wo = kWo[1], wi = normalize(Vec3(-0.4f, 0.2f, 0.7f));
-  const float len = 0.5f * (1 / cos_inside(wo.z, eta) + 1 / cos_inside(wi.z, eta));
+  const float len = 0.5f * (1 / test::cos_inside(wo.z, eta) + 1 / test::cos_inside(wi.z, eta));
   const float clear = 0.5f * kInvPi * wi.z * (1 - fresnel_dielectric(wo.z, eta)) * (1 - fresnel_dielectric(wi.z, eta)) /
                       (eta * eta);
   SurfaceInteraction si;

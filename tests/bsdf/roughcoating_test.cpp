@@ -21,13 +21,8 @@
 namespace tessera {
 namespace {
 
-using test::albedo;
-using test::AlbedoEstimate;
 using test::constant;
 using test::kWo;
-using test::rough_metal;
-
-float cos_inside(float c, float eta) { return std::sqrt(1.f - (1.f - c * c) / (eta * eta)); }
 
 // A constant that is not a ConstantTexture, to take the textured-roughness path.
 class UniformTexture final : public Texture {
@@ -49,10 +44,10 @@ TEST(RoughCoating, Chi2SampleMatchesPdf) {
   };
   const std::vector<Case> cases = {
       {MicrofacetType::Beckmann, 0.05f, 1.5f, make_diffuse_bsdf(constant(0.5f)), Rgb(0.f)},
-      {MicrofacetType::Beckmann, 0.3f, 1.33f, rough_metal("Cu", MicrofacetType::Beckmann, 0.2f), Rgb(0.f)},
+      {MicrofacetType::Beckmann, 0.3f, 1.33f, test::rough_metal("Cu", MicrofacetType::Beckmann, 0.2f), Rgb(0.f)},
       {MicrofacetType::Beckmann, 1.f, 1.7f, make_diffuse_bsdf(constant(0.8f)), Rgb(0.5f, 1.f, 2.f)},
       {MicrofacetType::Ggx, 0.1f, 2.f, make_diffuse_bsdf(constant(0.5f)), Rgb(0.f)},
-      {MicrofacetType::Ggx, 1.f, 1.5f, rough_metal("Au", MicrofacetType::Ggx, 0.5f), Rgb(0.3f)},
+      {MicrofacetType::Ggx, 1.f, 1.5f, test::rough_metal("Au", MicrofacetType::Ggx, 0.5f), Rgb(0.3f)},
       {MicrofacetType::Phong, 0.3f, 1.5f, make_diffuse_bsdf(constant(0.5f)), Rgb(0.f)},
   };
   const int test_count = int(cases.size() * std::size(kWo));
@@ -68,7 +63,7 @@ TEST(RoughCoating, Chi2SampleMatchesPdf) {
 }
 
 TEST(RoughCoating, WeightIsEvalOverPdf) {
-  auto nested = rough_metal("Cu", MicrofacetType::Ggx, 0.3f);
+  auto nested = test::rough_metal("Cu", MicrofacetType::Ggx, 0.3f);
   auto bsdf = make_roughcoating_bsdf(MicrofacetType::Ggx, constant(0.2f), 1.5f, 1.f, constant(Rgb(0.1f, 0.2f, 0.3f)),
                                      constant(0.9f), nested.get());
   EXPECT_FALSE(bsdf->is_delta());
@@ -103,7 +98,7 @@ TEST(RoughCoating, LambertianUnderCoatClosedFormAndSmoothLimit) {
     }
   }
   for (int i = 0; i < 3; ++i) {
-    const AlbedoEstimate a = albedo(*smoothish, kWo[i]), b = albedo(*smooth, kWo[i]);
+    const test::AlbedoEstimate a = test::albedo(*smoothish, kWo[i]), b = test::albedo(*smooth, kWo[i]);
     EXPECT_NEAR(a.mean, b.mean, 4 * (a.se + b.se) + 5e-3) << kWo[i].z;
   }
 }
@@ -111,22 +106,13 @@ TEST(RoughCoating, LambertianUnderCoatClosedFormAndSmoothLimit) {
 TEST(RoughCoating, AbsorptionAlongRefractedDirections) {
   const float eta = 1.4f, d = 0.7f;
   const Rgb sigma(0.1f, 0.5f, 2.f);
-  auto nested = rough_metal("Ag", MicrofacetType::Ggx, 0.5f);
+  auto nested = test::rough_metal("Ag", MicrofacetType::Ggx, 0.5f);
   // No interface reflection, so that the ratio isolates the nested part.
   auto clear = make_roughcoating_bsdf(MicrofacetType::Ggx, constant(0.2f), eta, d, constant(0.f), constant(0.f),
                                       nested.get());
   auto tinted = make_roughcoating_bsdf(MicrofacetType::Ggx, constant(0.2f), eta, d, constant(sigma), constant(0.f),
                                        nested.get());
-  SurfaceInteraction si;
-  for (Vec3 wo : kWo) {
-    for (float theta : {0.f, 40.f, 80.f}) {
-      const Vec3 wi = test::direction_deg(theta, 170.f);
-      const Rgb a = clear->eval(si, wo, wi), b = tinted->eval(si, wo, wi);
-      ASSERT_GT(a.g, 0.f);
-      const float len = d * (1 / cos_inside(wo.z, eta) + 1 / cos_inside(wi.z, eta));
-      for (int c = 0; c < 3; ++c) EXPECT_NEAR(b[c] / a[c], std::exp(-sigma[c] * len), 1e-4f) << wo.z << " " << theta;
-    }
-  }
+  test::expect_absorption_along_refracted(*clear, *tinted, nullptr, eta, d, sigma);
 }
 
 // A textured roughness uses tables over alpha: at a node it matches the constant-alpha tables,
@@ -154,7 +140,7 @@ TEST(RoughCoating, TexturedAlpha) {
 // everything; a perfect (delta) mirror under it as well, through delta nested samples.
 TEST(RoughCoating, WhiteFurnace) {
   auto white = make_diffuse_bsdf(constant(1.f));
-  auto rough_mirror = rough_metal("none", MicrofacetType::Beckmann, 0.2f);
+  auto rough_mirror = test::rough_metal("none", MicrofacetType::Beckmann, 0.2f);
   auto mirror = make_conductor_bsdf(*lookup_metal("none"), constant(1.f));
   for (MicrofacetType type : {MicrofacetType::Beckmann, MicrofacetType::Ggx}) {
     for (float alpha : {0.05f, 0.3f, 1.f}) {
@@ -162,7 +148,7 @@ TEST(RoughCoating, WhiteFurnace) {
                                  static_cast<const Bsdf*>(mirror.get())}) {
         auto bsdf = make_roughcoating_bsdf(type, constant(alpha), 1.5f, 1.f, constant(0.f), constant(1.f), nested);
         for (Vec3 wo : kWo) {
-          const AlbedoEstimate a = albedo(*bsdf, wo);
+          const test::AlbedoEstimate a = test::albedo(*bsdf, wo);
           EXPECT_LE(a.mean, 1.0 + 4 * a.se + 1e-3) << int(type) << " " << alpha << " " << wo.z;
           EXPECT_GT(a.mean, 0.1) << int(type) << " " << alpha << " " << wo.z;  // GGX alpha 1 at grazing: ~0.13
         }
@@ -185,7 +171,7 @@ TEST(RoughCoating, WhiteFurnace) {
 
 TEST(RoughCoating, FiniteAtGrazingAngles) {
   auto diffuse = make_diffuse_bsdf(constant(0.5f));
-  auto metal = rough_metal("Cu", MicrofacetType::Ggx, 0.05f);
+  auto metal = test::rough_metal("Cu", MicrofacetType::Ggx, 0.05f);
   Pcg32 rng(31);
   for (const Bsdf* nested : {static_cast<const Bsdf*>(diffuse.get()), static_cast<const Bsdf*>(metal.get())}) {
     for (MicrofacetType type : {MicrofacetType::Beckmann, MicrofacetType::Ggx, MicrofacetType::Phong}) {
