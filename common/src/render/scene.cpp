@@ -125,16 +125,16 @@ float Scene::transmittance(const Ray& ray) const {
   Ray r = ray;
   float tr = 1.f;
   SurfaceInteraction si;
-  for (int crossing = 0; crossing <= kMaxMaskCrossings; ++crossing) {
+  for (int crossing = 0;; ++crossing) {
     Hit hit;
     if (!accel_.intersect(r, hit)) return tr;
+    if (crossing == kMaxMaskCrossings) return 0.f;  // as intersect(): that one counts as opaque
     fill(r, hit, si);
     tr *= 1.f - masked_opacity(si);
-    if (!(tr > 0.f) || crossing == kMaxMaskCrossings) return 0.f;
+    if (!(tr > 0.f)) return 0.f;
     r = continue_ray(r, si, si.t);
     if (!(r.tmax > 0.f)) return tr;
   }
-  return 0.f;
 }
 
 const Light* Scene::sample_light(float u, float& pmf) const {
