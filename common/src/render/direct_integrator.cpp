@@ -37,7 +37,7 @@ class DirectIntegrator final : public Integrator {
       const Vec2 u_light = sampler.next_2d();
       if (bsdf->is_delta()) continue;
       float pmf = 0.f;
-      const Light* light = scene.sample_light(u_pick, pmf);
+      const Light* light = scene.sample_light({si.p, si.shading.n}, u_pick, pmf);
       LightSample ls;
       if (!light || !(pmf > 0.f) || !light->sample_li(si.p, u_light, ls)) continue;
       if (!(ls.pdf > 0.f) || ls.li.is_black()) continue;
@@ -69,14 +69,14 @@ class DirectIntegrator final : public Integrator {
         if (!area) continue;
         Rgb le = area->le(hit, -wi_world);
         if (le.is_black()) continue;
-        float light_pdf = bs.delta ? 0.f : area->pdf_li(si.p, hit) * scene.light_pmf(area);
+        float light_pdf = bs.delta ? 0.f : area->pdf_li(si.p, hit) * scene.light_pmf({si.p, si.shading.n}, area);
         float w = bs.delta ? 1.f : power_heuristic(fn_b * bs.pdf, fn_l * light_pdf);
         L += bs.weight * le * (w / fn_b);
       } else {
         for (const Light* env : scene.infinite_lights()) {
           Rgb le = env->le_env(wi_world);
           if (le.is_black()) continue;
-          float light_pdf = bs.delta ? 0.f : env->pdf_env(wi_world) * scene.light_pmf(env);
+          float light_pdf = bs.delta ? 0.f : env->pdf_env(wi_world) * scene.light_pmf({si.p, si.shading.n}, env);
           float w = bs.delta ? 1.f : power_heuristic(fn_b * bs.pdf, fn_l * light_pdf);
           L += bs.weight * le * (w / fn_b);
         }

@@ -23,7 +23,7 @@ class PathIntegrator final : public Integrator {
     int depth = 0;  // scattering events so far
     float prev_bsdf_pdf = 0.f;
     bool prev_delta = true;  // the camera "vertex" has no BSDF to combine with
-    Vec3 prev_p;
+    LightSampleContext prev_ctx;  // the previous vertex, for the light-selection pmf in MIS
     SurfaceInteraction si;
 
     for (;;) {
@@ -34,7 +34,7 @@ class PathIntegrator final : public Integrator {
             Rgb le = env->le_env(ray.d);
             if (le.is_black()) continue;
             float w = prev_delta ? 1.f
-                                 : power_heuristic(prev_bsdf_pdf, env->pdf_env(ray.d) * scene.light_pmf(env));
+                                 : power_heuristic(prev_bsdf_pdf, env->pdf_env(ray.d) * scene.light_pmf(prev_ctx, env));
             L += throughput * le * w;
           }
         }
@@ -46,7 +46,7 @@ class PathIntegrator final : public Integrator {
         Rgb le = area->le(si, wo_world);
         if (!le.is_black()) {
           float w = prev_delta ? 1.f
-                               : power_heuristic(prev_bsdf_pdf, area->pdf_li(prev_p, si) * scene.light_pmf(area));
+                               : power_heuristic(prev_bsdf_pdf, area->pdf_li(prev_ctx.p, si) * scene.light_pmf(prev_ctx, area));
           L += throughput * le * w;
         }
       }
@@ -74,7 +74,7 @@ class PathIntegrator final : public Integrator {
       prev_bsdf_pdf = bs.pdf;
       prev_delta = bs.delta;
       eta *= bs.eta;
-      prev_p = si.p;
+      prev_ctx = {si.p, si.shading.n};
       ++depth;
 
       // Russian roulette as Mitsuba 3: survival probability from the throughput, times eta^2 so that
@@ -96,7 +96,7 @@ class PathIntegrator final : public Integrator {
   Rgb sample_direct(const Scene& scene, const SurfaceInteraction& si, const Bsdf& bsdf, Vec3 wo,
                     float u_pick, Vec2 u_light, RenderCounters& counters) const {
     float pmf = 0.f;
-    const Light* light = scene.sample_light(u_pick, pmf);
+    const Light* light = scene.sample_light({si.p, si.shading.n}, u_pick, pmf);
     LightSample ls;
     if (!light || !(pmf > 0.f) || !light->sample_li(si.p, u_light, ls)) return {};
     if (!(ls.pdf > 0.f) || ls.li.is_black()) return {};

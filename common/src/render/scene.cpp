@@ -137,7 +137,7 @@ float Scene::transmittance(const Ray& ray) const {
   }
 }
 
-const Light* Scene::sample_light(float u, float& pmf) const {
+const Light* Scene::sample_light(const LightSampleContext& /*ctx*/, float u, float& pmf) const {
   if (lights.empty()) {
     pmf = 0.f;
     return nullptr;
@@ -146,7 +146,7 @@ const Light* Scene::sample_light(float u, float& pmf) const {
   return lights[i].get();
 }
 
-float Scene::light_pmf(const Light* light) const {
+float Scene::light_pmf(const LightSampleContext& /*ctx*/, const Light* light) const {
   if (!light || light->scene_index >= lights.size() || lights[light->scene_index].get() != light) return 0.f;
   return light_distr_.pmf(light->scene_index);
 }

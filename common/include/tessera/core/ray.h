@@ -18,6 +18,7 @@ struct Ray {
   Vec3 d;
   float tmin = 0.f;
   float tmax = kInfinity;
+  float time = 0.f;  // scene time of the ray, within the camera's shutter (motion blur)
   Vec3 at(float t) const { return o + d * t; }
 };
 

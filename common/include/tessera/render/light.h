@@ -28,6 +28,13 @@ struct LightSample {
   bool delta = false;
 };
 
+/// Where a light is sampled from: the shading point and, on surfaces, its (shading-side) normal;
+/// `n` is zero for points in a medium. Light selection may use both (a light hierarchy does).
+struct LightSampleContext {
+  Vec3 p;
+  Vec3 n;
+};
+
 class Light {
  public:
   virtual ~Light() = default;

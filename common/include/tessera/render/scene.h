@@ -65,9 +65,11 @@ class Scene {
   /// True when some shape's BSDF has opacity (else intersect/transmittance take the fast path).
   bool has_masks() const { return has_masks_; }
 
-  /// Picks a light in proportion to power. Null when the scene has none.
-  const Light* sample_light(float u, float& pmf) const;
-  float light_pmf(const Light* light) const;
+  /// Picks a light to sample from the shading point `ctx` (by power; a light hierarchy may use the
+  /// point and normal). Null when the scene has none. light_pmf() is the probability that
+  /// sample_light() with the same `ctx` returns `light` (for MIS of emitters hit by BSDF rays).
+  const Light* sample_light(const LightSampleContext& ctx, float u, float& pmf) const;
+  float light_pmf(const LightSampleContext& ctx, const Light* light) const;
   const std::vector<const Light*>& infinite_lights() const { return infinite_lights_; }
 
   const Bvh& accel() const { return accel_; }
