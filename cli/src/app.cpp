@@ -40,6 +40,10 @@ int main_entry(int argc, char** argv) {
   r->add_option("-D", defines, "Override a scene <default>: -D name=value");
   r->add_option("--integrator", render.integrator, "Override the integrator")
       ->check(CLI::IsMember({"path", "direct"}));
+  r->add_option("--light-selection", render.light_selection,
+                "How next-event estimation picks a light: power (alias table) or bvh (light hierarchy; "
+                "default)")
+      ->check(CLI::IsMember({"power", "bvh"}));
   r->add_flag("--allow-unsupported", render.allow_unsupported,
               "Substitute documented fallbacks for unsupported plugins/parameters");
   r->add_flag("-q,--quiet", render.quiet, "No progress output");

@@ -93,6 +93,14 @@ int run_render(const RenderOptions& options) {
     LoadResult loaded = load_scene(desc, load_options);
     double load_s = seconds_since(t_load);
     print_messages(loaded);
+    if (!options.light_selection.empty()) {
+      LightSelection selection;
+      if (!parse_light_selection(options.light_selection, selection)) {
+        std::cerr << "tessera render: --light-selection: unknown strategy '" << options.light_selection << "'\n";
+        return 2;
+      }
+      loaded.scene->set_light_selection(selection);
+    }
     const Scene& scene = *loaded.scene;
 
     RenderSettings settings;
@@ -120,10 +128,11 @@ int run_render(const RenderOptions& options) {
     const auto& c = stats.counters;
     BvhStats bvh = scene.accel().stats();
     std::fprintf(stderr,
-                 "scene %s: %zu triangles, %zu shapes, %zu lights; BVH %zu nodes, %.1f MB\n"
+                 "scene %s: %zu triangles, %zu shapes, %zu lights (%zu selectable, %s selection); BVH %zu nodes, %.1f MB\n"
                  "times: parse %.3f s, load %.3f s (BVH build %.3f s), render %.3f s\n"
                  "render: %dx%d, %d spp, %d threads: %.3g samples/s, %.3g rays/s",
                  options.scene.c_str(), scene.num_triangles(), scene.shapes.size(), scene.lights.size(),
+                 scene.light_sampler().lights().size(), light_selection_name(scene.light_sampler().strategy()),
                  bvh.nodes, double(bvh.bytes) / 1e6, parse_s, load_s - scene.bvh_build_seconds(),
                  scene.bvh_build_seconds(), stats.seconds, film.width(), film.height(), settings.spp,
                  settings.threads, double(c.samples) / std::max(stats.seconds, 1e-9),

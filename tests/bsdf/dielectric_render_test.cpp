@@ -23,12 +23,7 @@ void expect_furnace_is_one(std::shared_ptr<Bsdf> bsdf, const char* what) {
   scene.lights.push_back(std::make_unique<ConstantLight>(Rgb(1.f)));
   test::set_camera(scene, Vec3(0.f), 45.f, 16, 16);
   scene.finalize();
-  RenderSettings s;
-  s.spp = 64;
-  s.seed = 1;
-  s.threads = 2;
-  s.tile_size = 16;
-  Film film = render(scene, s);
+  Film film = render(scene, test::render_settings(64));
   double sum = 0;
   int n = 0;
   for (int y = 0; y < 16; ++y)
@@ -58,12 +53,7 @@ TEST(DielectricRender, TransmittanceTintsTheSphere) {
   scene.lights.push_back(std::make_unique<ConstantLight>(Rgb(1.f)));
   test::set_camera(scene, Vec3(0.f), 45.f, 16, 16);
   scene.finalize();
-  RenderSettings s;
-  s.spp = 64;
-  s.seed = 1;
-  s.threads = 2;
-  s.tile_size = 16;
-  Film film = render(scene, s);
+  Film film = render(scene, test::render_settings(64));
   const float c = film.mean({8, 8}).g;
   EXPECT_LT(c, 0.5f);
   EXPECT_GT(c, 0.2f);

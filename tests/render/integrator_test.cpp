@@ -52,14 +52,7 @@ Check check_film(const Film& film, double expected, double sigmas,
   return c;
 }
 
-RenderSettings settings(int spp) {
-  RenderSettings s;
-  s.spp = spp;
-  s.seed = 1;
-  s.threads = 2;
-  s.tile_size = 16;
-  return s;
-}
+RenderSettings settings(int spp) { return test::render_settings(spp); }
 
 // Inside a closed diffuse sphere of radius 1 and albedo rho with a point light of intensity pi at
 // its centre, irradiance from the light is pi everywhere, so L = rho (1 + L): L = rho / (1 - rho),

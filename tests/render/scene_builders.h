@@ -6,6 +6,7 @@
 #include "tessera/light/area.h"
 #include "tessera/light/point.h"
 #include "tessera/render/film.h"
+#include "tessera/render/renderer.h"
 #include "tessera/render/scene.h"
 
 #include <cmath>
@@ -51,6 +52,17 @@ inline void set_camera(Scene& scene, Vec3 origin, float fov_x, int width, int he
   scene.camera = make_perspective_camera(Transform::translate(origin), fov_x, width, height, 1e-3f, 1e4f);
   scene.film.width = width;
   scene.film.height = height;
+}
+
+/// Fixed seed, two threads and small tiles: what the render tests use (images are bit-identical for
+/// any thread count and tile size anyway; these only keep the tests' work predictable).
+inline RenderSettings render_settings(int spp, uint32_t seed = 1, int tile_size = 16) {
+  RenderSettings s;
+  s.spp = spp;
+  s.seed = seed;
+  s.threads = 2;
+  s.tile_size = tile_size;
+  return s;
 }
 
 }  // namespace tessera::test

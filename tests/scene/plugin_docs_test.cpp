@@ -56,7 +56,7 @@ std::string docs_path() { return test::source_dir() + "/docs/plugins.md"; }
 
 TEST(PluginDocs, ListsExactlyTheRegisteredPlugins) {
   Documented docs = read_docs(docs_path());
-  for (const char* tag : {"bsdf", "texture", "shape", "emitter"}) {
+  for (const char* tag : {"bsdf", "texture", "shape", "emitter", "medium", "phase"}) {
     std::set<std::string> registered, documented;
     for (const auto& t : registered_plugins(tag)) registered.insert(t);
     for (const auto& [key, params] : docs)
@@ -83,6 +83,11 @@ std::string snippet(const std::string& tag, const std::string& type, const std::
     return "<shape type=\"sphere\"><bsdf type=\"diffuse\"><texture name=\"reflectance\" type=\"" + type +
            "\">" + inner + "</texture></bsdf></shape>";
   }
+  if (tag == "medium")
+    return "<shape type=\"sphere\"><medium name=\"interior\" type=\"" + type + "\"/></shape>";
+  if (tag == "phase")
+    return "<shape type=\"sphere\"><medium name=\"interior\" type=\"homogeneous\"><phase type=\"" + type +
+           "\"/></medium></shape>";
   if (tag == "emitter" && type == "area") return "<shape type=\"sphere\"><emitter type=\"area\"/></shape>";
   if (tag == "emitter" && type == "envmap")
     return "<emitter type=\"envmap\"><string name=\"filename\" value=\"" + tex_file + "\"/></emitter>";
@@ -105,17 +110,24 @@ TEST(PluginDocs, DocumentsExactlyTheParametersPluginsRead) {
     (void)load_scene(parse_scene_file(path), options);
   }
   std::string body;
-  for (const char* tag : {"bsdf", "texture", "emitter"})
+  for (const char* tag : {"bsdf", "texture", "emitter", "medium", "phase"})
     for (const auto& type : registered_plugins(tag)) body += snippet(tag, type, tex) + "\n";
   for (const char* shape : {"sphere", "rectangle", "cube", "disk"})
     body += std::string("<shape type=\"") + shape + "\"/>\n";
   body += "<shape type=\"ply\"><string name=\"filename\" value=\"" + test::source_dir() +
           "/tests/scene/data/triangle.ply\"/></shape>\n";
-  for (const char* integrator : {"path", "direct"}) {
+  for (const char* integrator : {"path", "volpath", "direct"}) {
     std::string xml = std::string("<scene version=\"0.6.0\"><integrator type=\"") + integrator + "\"/>" +
                       "<sensor type=\"perspective\"><film type=\"hdrfilm\"/><sampler type=\"independent\"/>"
                       "</sensor>" + body + "</scene>";
     (void)load_scene(parse_scene_string(xml, "mem/catalog.xml"), options);
+  }
+  // The sensors the shared scenes do not use.
+  for (const char* sensor : {"<sensor type=\"thinlens\"><float name=\"aperture_radius\" value=\"0.1\"/>"
+                             "<float name=\"fov\" value=\"40\"/></sensor>",
+                             "<sensor type=\"orthographic\"/>"}) {
+    std::string xml = std::string("<scene version=\"0.6.0\">") + sensor + "<shape type=\"sphere\"/></scene>";
+    (void)load_scene(parse_scene_string(xml, "mem/sensors.xml"), options);
   }
 
   Documented docs = read_docs(docs_path());
@@ -129,7 +141,7 @@ TEST(PluginDocs, DocumentsExactlyTheParametersPluginsRead) {
     }
     auto it = docs.find(key);
     bool supported_type = key.first != "bsdf" && key.first != "texture" && key.first != "shape" &&
-                                  key.first != "emitter"
+                                  key.first != "emitter" && key.first != "medium" && key.first != "phase"
                               ? true
                               : [&] {
                                   for (const auto& t : registered_plugins(key.first))

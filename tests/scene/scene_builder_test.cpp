@@ -301,7 +301,7 @@ const char* kUnsupportedScene = R"(<bsdf type="made_up_bsdf" id="mystery">
 <bsdf type="made_up_bsdf" id="never_used"/>
 <shape type="sphere"><ref id="mystery"/></shape>
 <shape type="sphere"><ref id="d"/>
-  <medium type="homogeneous" name="interior"/>
+  <medium type="made_up_medium" name="interior"/>
 </shape>
 <shape type="made_up_shape"/>
 <emitter type="made_up_emitter"/>
@@ -330,7 +330,7 @@ TEST(SceneBuilder, UnsupportedItemsAreReportedAllAtOnce) {
   EXPECT_TRUE(has(2, "bsdf 'made_up_bsdf' (id 'mystery')"));
   EXPECT_TRUE(has(6, "parameter 'alpha' of bsdf 'diffuse'"));
   EXPECT_TRUE(has(7, "texture 'made_up_texture'"));
-  EXPECT_TRUE(has(12, "medium 'homogeneous'"));
+  EXPECT_TRUE(has(12, "medium 'made_up_medium'"));
   EXPECT_TRUE(has(14, "shape 'made_up_shape'"));
   EXPECT_TRUE(has(15, "emitter 'made_up_emitter'"));
   EXPECT_TRUE(has(17, "parameter 'bogus' of sensor 'perspective'"));
@@ -359,8 +359,8 @@ TEST(SceneBuilder, AllowUnsupportedSubstitutesFallbacks) {
 }
 
 TEST(SceneBuilder, UnsupportedSensorFilterIntegratorAndInstancedEmitter) {
-  const std::string body = R"(<integrator type="bdpt"><integer name="max_depth" value="4"/></integrator>
-<sensor type="thinlens"><float name="fov" value="30"/><float name="aperture_radius" value="0.1"/>
+  const std::string body = R"(<integrator type="made_up_integrator"><integer name="max_depth" value="4"/></integrator>
+<sensor type="spherical"><float name="fov" value="30"/><float name="aperture_radius" value="0.1"/>
   <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/>
     <rfilter type="mitchell"/></film>
   <sampler type="made_up_sampler"><integer name="sample_count" value="9"/></sampler>
@@ -376,8 +376,8 @@ TEST(SceneBuilder, UnsupportedSensorFilterIntegratorAndInstancedEmitter) {
   } catch (const UnsupportedError& e) {
     items = e.items();
   }
-  std::vector<std::pair<int, std::string>> expected = {{2, "integrator 'bdpt'"},
-                                                       {3, "sensor 'thinlens'"},
+  std::vector<std::pair<int, std::string>> expected = {{2, "integrator 'made_up_integrator'"},
+                                                       {3, "sensor 'spherical'"},
                                                        {5, "rfilter 'mitchell'"},
                                                        {6, "sampler 'made_up_sampler'"},
                                                        {9, "area emitter inside a shapegroup"}};

@@ -8,6 +8,8 @@
 
 #include "tessera/core/frame.h"
 #include "tessera/core/sampling.h"
+#include "tessera/light/light_bounds.h"
+#include "tessera/light/triangle_light.h"
 #include "tessera/scene/load_context.h"
 
 #include <algorithm>
@@ -97,6 +99,26 @@ class AreaLight final : public Light {
   }
 
   float power() const override { return kPi * shape_.area() * radiance_.luminance(); }
+
+  // Whole shapes: a sphere (or an unsplit mesh) may emit in every direction.
+  bool light_bounds(LightBounds& out) const override {
+    out.bounds = shape_.bounds();
+    out.w = Vec3(0.f, 0.f, 1.f);
+    out.phi = power();
+    out.cos_theta_o = -1.f;
+    out.cos_theta_e = 0.f;
+    out.two_sided = false;
+    return out.phi > 0.f && !out.bounds.empty();
+  }
+
+  std::vector<std::unique_ptr<Light>> make_primitive_lights() const override {
+    std::vector<std::unique_ptr<Light>> out;
+    if (shape_.kind() != Shape::Kind::Mesh) return out;
+    const auto& mesh = static_cast<const TriangleMeshShape&>(shape_);
+    out.reserve(mesh.num_primitives());
+    for (uint32_t t = 0; t < mesh.num_primitives(); ++t) out.push_back(make_triangle_light(mesh, t, radiance_));
+    return out;
+  }
 
  private:
   bool outside_sphere(Vec3 ref_p) const {

@@ -1,5 +1,6 @@
 #include "tessera/light/point.h"
 
+#include "tessera/light/light_bounds.h"
 #include "tessera/scene/load_context.h"
 
 namespace tessera {
@@ -26,6 +27,18 @@ class PointLight final : public Light {
 
   bool is_delta() const override { return true; }
   float power() const override { return 4.f * kPi * intensity_.luminance(); }
+
+  // A point emitting in every direction: any axis, theta_o = pi.
+  bool light_bounds(LightBounds& out) const override {
+    out.bounds = Bounds3();
+    out.bounds.extend(position_);
+    out.w = Vec3(0.f, 0.f, 1.f);
+    out.phi = power();
+    out.cos_theta_o = -1.f;
+    out.cos_theta_e = 0.f;
+    out.two_sided = false;
+    return out.phi > 0.f;
+  }
 
  private:
   Vec3 position_;

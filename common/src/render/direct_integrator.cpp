@@ -46,6 +46,7 @@ class DirectIntegrator final : public Integrator {
       Rgb f = bsdf->eval(si, wo, wi);
       if (f.is_black()) continue;
       Ray shadow = ls.dist < kInfinity ? spawn_ray_to(si.p, si.ng, ls.p_light) : spawn_ray(si.p, si.ng, ls.wi);
+      shadow.time = ray.time;
       ++counters.shadow_rays;
       const float tr = scene.transmittance(shadow);
       if (!(tr > 0.f)) continue;
@@ -62,6 +63,7 @@ class DirectIntegrator final : public Integrator {
       const Vec3 wi_world = si.to_world(bs.wi);
       if (!consistent_side(si, wi_world, bs.wi)) continue;
       Ray next = spawn_ray(si.p, si.ng, wi_world);
+      next.time = ray.time;
       ++counters.bounce_rays;
       SurfaceInteraction hit;
       if (scene.intersect(next, hit)) {

@@ -16,7 +16,7 @@ bool reconcile_shading_frame(SurfaceInteraction& si, Vec3 wo_world, bool strict_
 }
 
 const Bsdf* SurfaceInteraction::bsdf() const { return shape ? shape->bsdf : nullptr; }
-const Light* SurfaceInteraction::area_light() const { return shape ? shape->light : nullptr; }
+const Light* SurfaceInteraction::area_light() const { return shape ? shape->area_light(prim) : nullptr; }
 
 namespace {
 

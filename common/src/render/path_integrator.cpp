@@ -1,6 +1,12 @@
 // Unidirectional path tracer (see integrator.h): next-event estimation and BSDF sampling at each
 // vertex, combined with the power heuristic; emitters hit by BSDF-sampled rays are weighted against
 // the light-sampling density at the previous vertex (pdf_li or pdf_env times the selection pmf).
+//
+// As `volpath` it also tracks participating media: each segment samples the current medium's
+// free-flight distance; a scattering point does next-event estimation with the phase function and
+// continues in a phase-sampled direction, and `null` surfaces only switch the medium. Shadow rays
+// carry the medium's transmittance (Scene::transmittance with a medium). Transmittance is the same
+// factor for both strategies that can reach a light, so the MIS weights use the directional pdfs.
 #include "tessera/core/frame.h"
 #include "tessera/core/sampling.h"
 #include "tessera/render/integrator.h"
@@ -10,52 +16,119 @@
 namespace tessera {
 namespace {
 
+// A path crossing more index-matched boundaries than this in one segment is cut (a ray caught
+// between coincident null surfaces would otherwise never advance).
+constexpr int kMaxNullCrossings = 256;
+
+// Where next-event estimation happens: a surface (bsdf set) or a point in a medium (phase set).
+struct Vertex {
+  const SurfaceInteraction* si = nullptr;
+  const Bsdf* bsdf = nullptr;
+  Vec3 wo;  // local shading frame for a surface, world space in a medium
+  const PhaseFunction* phase = nullptr;
+  Vec3 p, ng;  // ng is zero in a medium: no ray offset, no side test
+  float time = 0.f;  // the path's time (motion blur): shadow rays see the scene at that instant
+  const Medium* medium = nullptr;  // medium around the vertex (on a surface: resolved per light side)
+};
+
 class PathIntegrator final : public Integrator {
  public:
-  explicit PathIntegrator(const IntegratorSettings& s) : s_(s) {}
+  PathIntegrator(const IntegratorSettings& s, bool volumetric) : s_(s), volumetric_(volumetric) {}
 
   Rgb li(const Scene& scene, const Ray& camera_ray, Sampler& sampler,
          RenderCounters& counters) const override {
     if (s_.max_depth == 0) return {};
+    const bool media = volumetric_ && scene.has_media();
+    const Medium* medium = media ? scene.camera_medium : nullptr;
     Rgb L, throughput(1.f);
     float eta = 1.f;  // product of the relative IORs crossed by refraction (BsdfSample::eta)
     Ray ray = camera_ray;
     int depth = 0;  // scattering events so far
-    float prev_bsdf_pdf = 0.f;
+    int null_crossings = 0;
+    float prev_pdf = 0.f;
     bool prev_delta = true;  // the camera "vertex" has no BSDF to combine with
     LightSampleContext prev_ctx;  // the previous vertex, for the light-selection pmf in MIS
     SurfaceInteraction si;
 
     for (;;) {
+      ray.time = camera_ray.time;  // every ray of a path sees the scene at the camera ray's time
       const bool visible_emitters = depth > 0 || !s_.hide_emitters;
-      if (!scene.intersect(ray, si)) {
+      // Media take two more dimensions per segment (sampler.h); scenes without media keep the layout.
+      const Vec2 u_medium = media ? sampler.next_2d() : Vec2();
+      const bool found = scene.intersect(ray, si, media);
+
+      if (medium) {
+        MediumSample ms;
+        medium->sample(ray, found ? si.t : kInfinity, u_medium, ms);
+        throughput *= ms.weight;
+        if (throughput.is_black()) break;
+        if (ms.scattered) {
+          if (s_.max_depth >= 0 && depth + 1 >= s_.max_depth) break;
+          Vertex v;
+          v.p = ray.at(ms.t);
+          v.wo = -normalize(ray.d);
+          v.phase = &medium->phase();
+          v.medium = medium;
+          v.time = ray.time;
+          const float u_pick = sampler.next_1d();
+          const Vec2 u_light = sampler.next_2d();
+          (void)sampler.next_1d();  // the lobe dimension, unused by phase functions
+          const Vec2 u_dir = sampler.next_2d();
+          const float u_rr = sampler.next_1d();
+          L += throughput * sample_direct(scene, v, u_pick, u_light, counters);
+          Vec3 wi;
+          float pdf = 0.f;
+          const float weight = v.phase->sample(v.wo, u_dir, wi, pdf);
+          if (!(weight > 0.f) || !(pdf > 0.f)) break;
+          throughput *= weight;
+          prev_pdf = pdf;
+          prev_delta = false;
+          prev_ctx = {v.p, Vec3(0.f)};
+          ++depth;
+          null_crossings = 0;
+          if (!survives_roulette(depth, throughput, eta, u_rr)) break;
+          ray = Ray{v.p, wi};
+          ++counters.bounce_rays;
+          continue;
+        }
+      }
+
+      if (!found) {
         if (visible_emitters) {
           for (const Light* env : scene.infinite_lights()) {
             Rgb le = env->le_env(ray.d);
             if (le.is_black()) continue;
-            float w = prev_delta ? 1.f
-                                 : power_heuristic(prev_bsdf_pdf, env->pdf_env(ray.d) * scene.light_pmf(prev_ctx, env));
+            float w = prev_delta ? 1.f : power_heuristic(prev_pdf, env->pdf_env(ray.d) * scene.light_pmf(prev_ctx, env));
             L += throughput * le * w;
           }
         }
         break;
       }
 
+      const Bsdf* bsdf = si.bsdf();
+      if (media && bsdf && bsdf->is_null()) {
+        // An index-matched boundary: only the medium changes; the path vertex stays where it was.
+        if (++null_crossings > kMaxNullCrossings) break;
+        medium = medium_after(si, ray.d, medium);
+        ray = spawn_ray(si.p, si.ng, ray.d);
+        continue;
+      }
+      null_crossings = 0;
+
       const Vec3 wo_world = -ray.d;
       if (const Light* area = si.area_light(); area && visible_emitters) {
         Rgb le = area->le(si, wo_world);
         if (!le.is_black()) {
           float w = prev_delta ? 1.f
-                               : power_heuristic(prev_bsdf_pdf, area->pdf_li(prev_ctx.p, si) * scene.light_pmf(prev_ctx, area));
+                               : power_heuristic(prev_pdf, area->pdf_li(prev_ctx.p, si) * scene.light_pmf(prev_ctx, area));
           L += throughput * le * w;
         }
       }
 
       if (s_.max_depth >= 0 && depth + 1 >= s_.max_depth) break;
       if (!reconcile_shading_frame(si, wo_world, s_.strict_normals)) break;
-      const Vec3 wo = si.to_local(wo_world);
-      const Bsdf* bsdf = si.bsdf();
       if (!bsdf) break;
+      const Vec3 wo = si.to_local(wo_world);
 
       // Fixed dimension layout per bounce (see sampler.h), drawn whether used or not.
       const float u_pick = sampler.next_1d();
@@ -64,27 +137,30 @@ class PathIntegrator final : public Integrator {
       const Vec2 u_bsdf = sampler.next_2d();
       const float u_rr = sampler.next_1d();
 
-      if (!bsdf->is_delta()) L += throughput * sample_direct(scene, si, *bsdf, wo, u_pick, u_light, counters);
+      if (!bsdf->is_delta()) {
+        Vertex v;
+        v.si = &si;
+        v.bsdf = bsdf;
+        v.wo = wo;
+        v.p = si.p;
+        v.ng = si.ng;
+        v.medium = medium;
+        v.time = ray.time;
+        L += throughput * sample_direct(scene, v, u_pick, u_light, counters);
+      }
 
       BsdfSample bs;
       if (!bsdf->sample(si, wo, u_lobe, u_bsdf, bs)) break;
       const Vec3 wi_world = si.to_world(bs.wi);
       if (!consistent_side(si, wi_world, bs.wi)) break;
       throughput *= bs.weight;
-      prev_bsdf_pdf = bs.pdf;
+      prev_pdf = bs.pdf;
       prev_delta = bs.delta;
       eta *= bs.eta;
       prev_ctx = {si.p, si.shading.n};
       ++depth;
-
-      // Russian roulette as Mitsuba 3: survival probability from the throughput, times eta^2 so that
-      // refraction's radiance scaling does not kill paths inside glass early; capped at 0.95.
-      if (depth >= s_.rr_depth) {
-        float q = std::min(throughput.max_value() * eta * eta, 0.95f);
-        if (!(u_rr < q)) break;
-        throughput *= 1.f / q;
-      }
-      if (throughput.is_black()) break;
+      if (media) medium = medium_after(si, wi_world, medium);
+      if (!survives_roulette(depth, throughput, eta, u_rr)) break;
       ray = spawn_ray(si.p, si.ng, wi_world);
       ++counters.bounce_rays;
     }
@@ -92,40 +168,65 @@ class PathIntegrator final : public Integrator {
   }
 
  private:
-  // One light sample, MIS-weighted against the BSDF; not yet multiplied by the throughput.
-  Rgb sample_direct(const Scene& scene, const SurfaceInteraction& si, const Bsdf& bsdf, Vec3 wo,
-                    float u_pick, Vec2 u_light, RenderCounters& counters) const {
+  // Russian roulette as Mitsuba 3: survival probability from the throughput, times eta^2 so that
+  // refraction's radiance scaling does not kill paths inside glass early; capped at 0.95.
+  bool survives_roulette(int depth, Rgb& throughput, float eta, float u_rr) const {
+    if (depth >= s_.rr_depth) {
+      float q = std::min(throughput.max_value() * eta * eta, 0.95f);
+      if (!(u_rr < q)) return false;
+      throughput *= 1.f / q;
+    }
+    return !throughput.is_black();
+  }
+
+  // One light sample, MIS-weighted against the BSDF or phase function; not yet multiplied by the
+  // throughput.
+  Rgb sample_direct(const Scene& scene, const Vertex& v, float u_pick, Vec2 u_light, RenderCounters& counters) const {
     float pmf = 0.f;
-    const Light* light = scene.sample_light({si.p, si.shading.n}, u_pick, pmf);
+    const LightSampleContext ctx{v.p, v.si ? v.si->shading.n : Vec3(0.f)};
+    const Light* light = scene.sample_light(ctx, u_pick, pmf);
     LightSample ls;
-    if (!light || !(pmf > 0.f) || !light->sample_li(si.p, u_light, ls)) return {};
+    if (!light || !(pmf > 0.f) || !light->sample_li(v.p, u_light, ls)) return {};
     if (!(ls.pdf > 0.f) || ls.li.is_black()) return {};
-    const Vec3 wi = si.to_local(ls.wi);
-    if (!consistent_side(si, ls.wi, wi)) return {};
-    Rgb f = bsdf.eval(si, wo, wi);
+    Rgb f;
+    float scatter_pdf = 0.f;
+    const Medium* shadow_medium = v.medium;
+    if (v.si) {
+      const Vec3 wi = v.si->to_local(ls.wi);
+      if (!consistent_side(*v.si, ls.wi, wi)) return {};
+      f = v.bsdf->eval(*v.si, v.wo, wi);
+      if (!ls.delta) scatter_pdf = v.bsdf->pdf(*v.si, v.wo, wi);
+      if (volumetric_) shadow_medium = medium_after(*v.si, ls.wi, v.medium);
+    } else {
+      f = Rgb(v.phase->eval(v.wo, ls.wi));
+      if (!ls.delta) scatter_pdf = v.phase->pdf(v.wo, ls.wi);
+    }
     if (f.is_black()) return {};
-    Ray shadow = ls.dist < kInfinity ? spawn_ray_to(si.p, si.ng, ls.p_light) : spawn_ray(si.p, si.ng, ls.wi);
+    Ray shadow = ls.dist < kInfinity ? spawn_ray_to(v.p, v.ng, ls.p_light) : spawn_ray(v.p, v.ng, ls.wi);
+    shadow.time = v.time;
     ++counters.shadow_rays;
-    const float tr = scene.transmittance(shadow);
-    if (!(tr > 0.f)) return {};
+    const Rgb tr = volumetric_ ? scene.transmittance(shadow, shadow_medium) : Rgb(scene.transmittance(shadow));
+    if (tr.is_black()) return {};
     float light_pdf = ls.pdf * pmf;
-    float w = ls.delta ? 1.f : power_heuristic(light_pdf, bsdf.pdf(si, wo, wi));
-    return f * ls.li * (tr * w / light_pdf);
+    float w = ls.delta ? 1.f : power_heuristic(light_pdf, scatter_pdf);
+    return f * ls.li * tr * (w / light_pdf);
   }
 
   IntegratorSettings s_;
+  bool volumetric_;
 };
 
 }  // namespace
 
 std::unique_ptr<Integrator> make_path_integrator(const IntegratorSettings& settings) {
-  return std::make_unique<PathIntegrator>(settings);
+  return std::make_unique<PathIntegrator>(settings, settings.type == IntegratorType::VolPath);
 }
 
 std::unique_ptr<Integrator> make_integrator(const IntegratorSettings& settings) {
   switch (settings.type) {
     case IntegratorType::Direct: return make_direct_integrator(settings);
-    case IntegratorType::Path: break;
+    case IntegratorType::Path:
+    case IntegratorType::VolPath: break;
   }
   return make_path_integrator(settings);
 }

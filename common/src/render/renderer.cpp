@@ -43,6 +43,8 @@ void render_tile_with(const Scene& scene, const Integrator& integrator, const Fi
   TESSERA_CHECK(scene.camera != nullptr);
   tile.reset(rect);
   Sampler sampler(scene.sampler.type, seed);
+  const bool timed = scene.has_shutter_interval();
+  const float open = scene.shutter_open, shutter = scene.shutter_close - scene.shutter_open;
   for (int y = rect.y0; y < rect.y1; ++y) {
     for (int x = rect.x0; x < rect.x1; ++x) {
       for (uint32_t s = sample_begin; s < sample_end; ++s) {
@@ -52,7 +54,10 @@ void render_tile_with(const Scene& scene, const Integrator& integrator, const Fi
         // Without a filter (scenes built in code): a box over the pixel.
         Vec2 offset = filter ? filter->sample(u_film) : Vec2(u_film.x - 0.5f, u_film.y - 0.5f);
         Vec2 raster(float(x) + 0.5f + offset.x, float(y) + 0.5f + offset.y);
-        Ray ray = scene.camera->generate_ray(raster, u_lens);
+        // Motion blur: a time in the shutter from a dedicated dimension (sampler.h); without it,
+        // the layout and every value are the same as before.
+        const float time = timed ? open + shutter * sampler.sample_1d_at(Sampler::kTimeDimension) : open;
+        Ray ray = scene.camera->generate_ray_at(raster, u_lens, time);
         ++tile.counters.camera_rays;
         Rgb L = integrator.li(scene, ray, sampler, tile.counters);
         tile.add_sample({x, y}, L);

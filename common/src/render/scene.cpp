@@ -14,6 +14,7 @@ void Scene::finalize() {
   std::vector<SpherePrim> spheres;
   size_t tri_count = 0, sphere_count = 0;
   for (const auto& s : shapes) {
+    if (s->motion) continue;  // moving shapes: build_motion()
     if (s->kind() == Shape::Kind::Mesh) tri_count += s->num_primitives();
     else sphere_count += 1;
   }
@@ -27,6 +28,7 @@ void Scene::finalize() {
   uint32_t next_tri = 0, next_sphere = uint32_t(tri_count);
   for (uint32_t si = 0; si < shapes.size(); ++si) {
     const Shape& s = *shapes[si];
+    if (s.motion) continue;
     if (s.kind() == Shape::Kind::Mesh) {
       const auto& mesh = static_cast<const TriangleMeshShape&>(s).mesh();
       shape_first_[si] = next_tri;
@@ -43,28 +45,29 @@ void Scene::finalize() {
     }
   }
   num_triangles_ = tri_count;
+  has_media_ = camera_medium != nullptr ||
+               std::any_of(shapes.begin(), shapes.end(), [](const auto& s) { return s->medium_interface; });
   has_masks_ = std::any_of(shapes.begin(), shapes.end(),
                            [](const auto& s) { return s->bsdf && s->bsdf->has_opacity(); });
   auto t0 = std::chrono::steady_clock::now();
   accel_ = Bvh::build(std::move(triangles), std::move(spheres));
   bvh_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  build_motion(uint32_t(tri_count + sphere_count));
 
-  Bounds3 b = accel_.bounds();
+  Bounds3 b = bounds();
   if (b.empty()) b.extend(Vec3(0.f));
   infinite_lights_.clear();
-  std::vector<float> power;
-  power.reserve(lights.size());
   for (auto& l : lights) {
     l->scene_index = uint32_t(&l - lights.data());
     l->preprocess(b);
     if (l->is_infinite()) infinite_lights_.push_back(l.get());
-    power.push_back(std::max(l->power(), 0.f));
   }
-  light_distr_ = Distribution1D(power);
+  light_sampler_.build(lights, shapes, integrator.light_selection);
 }
 
 void Scene::fill(const Ray& ray, const Hit& hit, SurfaceInteraction& si) const {
   TESSERA_DCHECK(hit.prim < prim_shape_.size());
+  if (hit.prim >= num_static_prims_) return fill_moving(ray, hit, si);
   uint32_t shape_index = prim_shape_[hit.prim];
   const Shape* shape = shapes[shape_index].get();
   shape->fill_interaction(ray, hit, hit.prim - shape_first_[shape_index], si);
@@ -80,6 +83,11 @@ constexpr int kMaxMaskCrossings = 64;
 float masked_opacity(const SurfaceInteraction& si) {
   const Bsdf* bsdf = si.bsdf();
   return bsdf && bsdf->has_opacity() ? bsdf->opacity(si) : 1.f;
+}
+
+bool is_null_surface(const SurfaceInteraction& si) {
+  const Bsdf* bsdf = si.bsdf();
+  return bsdf && bsdf->is_null();
 }
 
 // A uniform number from the ray itself (as pbrt-v4's alpha test): deterministic, independent of
@@ -101,9 +109,9 @@ Ray continue_ray(const Ray& r, const SurfaceInteraction& si, float t) {
 
 }  // namespace
 
-bool Scene::intersect(const Ray& ray, SurfaceInteraction& si) const {
+bool Scene::intersect(const Ray& ray, SurfaceInteraction& si, bool stop_at_null) const {
   Hit hit;
-  if (!accel_.intersect(ray, hit)) return false;
+  if (!closest_hit(ray, hit)) return false;
   fill(ray, hit, si);
   if (!has_masks_) return true;
   Ray r = ray;
@@ -111,9 +119,10 @@ bool Scene::intersect(const Ray& ray, SurfaceInteraction& si) const {
   for (int crossing = 0; crossing < kMaxMaskCrossings; ++crossing) {
     float opacity = masked_opacity(si);
     if (opacity >= 1.f || alpha_test_u(r) < opacity) break;
+    if (stop_at_null && is_null_surface(si)) break;
     t_before += si.t;
     r = continue_ray(r, si, si.t);
-    if (!(r.tmax > 0.f) || !accel_.intersect(r, hit)) return false;
+    if (!(r.tmax > 0.f) || !closest_hit(r, hit)) return false;
     fill(r, hit, si);
   }
   si.t += t_before;
@@ -121,13 +130,13 @@ bool Scene::intersect(const Ray& ray, SurfaceInteraction& si) const {
 }
 
 float Scene::transmittance(const Ray& ray) const {
-  if (!has_masks_) return accel_.occluded(ray) ? 0.f : 1.f;
+  if (!has_masks_) return occluded(ray) ? 0.f : 1.f;
   Ray r = ray;
   float tr = 1.f;
   SurfaceInteraction si;
   for (int crossing = 0;; ++crossing) {
     Hit hit;
-    if (!accel_.intersect(r, hit)) return tr;
+    if (!closest_hit(r, hit)) return tr;
     if (crossing == kMaxMaskCrossings) return 0.f;  // as intersect(): that one counts as opaque
     fill(r, hit, si);
     tr *= 1.f - masked_opacity(si);
@@ -137,18 +146,32 @@ float Scene::transmittance(const Ray& ray) const {
   }
 }
 
-const Light* Scene::sample_light(const LightSampleContext& /*ctx*/, float u, float& pmf) const {
-  if (lights.empty()) {
-    pmf = 0.f;
-    return nullptr;
+Rgb Scene::transmittance(const Ray& ray, const Medium* medium) const {
+  if (!has_media_) return Rgb(transmittance(ray));
+  Ray r = ray;
+  Rgb tr(1.f);
+  SurfaceInteraction si;
+  for (int crossing = 0;; ++crossing) {
+    Hit hit;
+    const bool found = closest_hit(r, hit);
+    if (medium) tr *= medium->transmittance(r, found ? hit.t : r.tmax);
+    if (!found) return tr;
+    if (crossing == kMaxMaskCrossings) return {};
+    fill(r, hit, si);
+    tr *= 1.f - masked_opacity(si);
+    if (tr.is_black()) return {};
+    if (is_null_surface(si)) medium = medium_after(si, r.d, medium);
+    r = continue_ray(r, si, si.t);
+    if (!(r.tmax > 0.f)) return tr;
   }
-  uint32_t i = light_distr_.sample_discrete(u, &pmf);
-  return lights[i].get();
 }
 
-float Scene::light_pmf(const LightSampleContext& /*ctx*/, const Light* light) const {
-  if (!light || light->scene_index >= lights.size() || lights[light->scene_index].get() != light) return 0.f;
-  return light_distr_.pmf(light->scene_index);
+const Light* Scene::sample_light(const LightSampleContext& ctx, float u, float& pmf) const {
+  return light_sampler_.sample(ctx, u, pmf);
+}
+
+float Scene::light_pmf(const LightSampleContext& ctx, const Light* light) const {
+  return light_sampler_.pmf(ctx, light);
 }
 
 }  // namespace tessera

@@ -23,8 +23,21 @@ struct BuildState {
 void build_integrator(BuildState& st);
 void build_sensor(BuildState& st);  // after the shapes: a missing sensor is fitted to the scene bounds
 void build_shapes(BuildState& st);
+// The sensor's shutterOpen/shutterClose into scene.shutter_*: before the shapes, which move over it.
+void read_shutter(BuildState& st);
 void build_emitters(BuildState& st);
 void report_unsupported(BuildState& st);
+
+/// The media a shape declares with <medium name="interior|exterior"> (nested or referenced).
+struct ShapeMedia {
+  const Medium* interior = nullptr;
+  const Medium* exterior = nullptr;
+  bool any = false;  // at least one was declared (the shape is a medium boundary)
+};
+ShapeMedia build_shape_media(BuildState& st, const SceneNode& shape);
+/// After shapes and sensor: the camera's medium, and the integrator against the media present
+/// (volpath without media is path; path with media ignores them, with one warning).
+void finish_media(BuildState& st);
 
 /// What --allow-unsupported substitutes for an unsupported plugin node.
 std::string fallback_for(const SceneNode& node);

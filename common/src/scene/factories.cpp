@@ -25,14 +25,24 @@ std::shared_ptr<Bsdf> make_blendbsdf(const SceneNode&, LoadContext&);
 std::shared_ptr<Bsdf> make_coating(const SceneNode&, LoadContext&);
 std::shared_ptr<Bsdf> make_roughcoating(const SceneNode&, LoadContext&);
 std::shared_ptr<Bsdf> make_mask(const SceneNode&, LoadContext&);
+std::shared_ptr<Bsdf> make_null(const SceneNode&, LoadContext&);
 // -- textures --
 std::shared_ptr<Texture> make_bitmap(const SceneNode&, LoadContext&);
 std::shared_ptr<Texture> make_checkerboard(const SceneNode&, LoadContext&);
 std::shared_ptr<Texture> make_scale(const SceneNode&, LoadContext&);
 // -- lights --
 std::unique_ptr<Light> make_point(const SceneNode&, LoadContext&);
+std::unique_ptr<Light> make_spot(const SceneNode&, LoadContext&);
 std::unique_ptr<Light> make_envmap(const SceneNode&, LoadContext&);
 std::unique_ptr<Light> make_constant(const SceneNode&, LoadContext&);
+std::unique_ptr<Light> make_directional(const SceneNode&, LoadContext&);
+std::unique_ptr<Light> make_sunsky(const SceneNode&, LoadContext&);
+std::unique_ptr<Light> make_sky(const SceneNode&, LoadContext&);
+std::unique_ptr<Light> make_sun(const SceneNode&, LoadContext&);
+// -- media and phase functions --
+std::shared_ptr<Medium> make_homogeneous(const SceneNode&, LoadContext&);
+std::shared_ptr<PhaseFunction> make_isotropic(const SceneNode&, LoadContext&);
+std::shared_ptr<PhaseFunction> make_hg(const SceneNode&, LoadContext&);
 // -- shapes --
 ShapeGeometry make_obj(const SceneNode&, LoadContext&);
 ShapeGeometry make_ply(const SceneNode&, LoadContext&);
@@ -75,6 +85,7 @@ const Entry<BsdfFactory> kBsdfs[] = {
     {"coating", make_coating},
     {"roughcoating", make_roughcoating},
     {"mask", make_mask},
+    {"null", make_null},
     {"", nullptr},
 };
 const Entry<TextureFactory> kTextures[] = {
@@ -85,8 +96,22 @@ const Entry<TextureFactory> kTextures[] = {
 };
 const Entry<LightFactory> kLights[] = {
     {"point", make_point},
+    {"spot", make_spot},
     {"envmap", make_envmap},
     {"constant", make_constant},
+    {"directional", make_directional},
+    {"sunsky", make_sunsky},
+    {"sky", make_sky},
+    {"sun", make_sun},
+    {"", nullptr},
+};
+const Entry<MediumFactory> kMedia[] = {
+    {"homogeneous", make_homogeneous},
+    {"", nullptr},
+};
+const Entry<PhaseFactory> kPhases[] = {
+    {"isotropic", make_isotropic},
+    {"hg", make_hg},
     {"", nullptr},
 };
 const Entry<ShapeFactory> kShapes[] = {
@@ -114,6 +139,8 @@ std::vector<std::string> registered_plugins(const std::string& tag) {
   if (tag == "bsdf") return names(kBsdfs);
   if (tag == "texture") return names(kTextures);
   if (tag == "shape") return names(kShapes);
+  if (tag == "medium") return names(kMedia);
+  if (tag == "phase") return names(kPhases);
   if (tag == "emitter") {
     auto out = names(kLights);
     out.push_back("area");  // made by the shape loader, not a table entry
@@ -125,6 +152,8 @@ std::vector<std::string> registered_plugins(const std::string& tag) {
 BsdfFactory find_bsdf_factory(const std::string& type) { return type.empty() ? nullptr : find(kBsdfs, type); }
 TextureFactory find_texture_factory(const std::string& type) { return type.empty() ? nullptr : find(kTextures, type); }
 LightFactory find_light_factory(const std::string& type) { return type.empty() ? nullptr : find(kLights, type); }
+MediumFactory find_medium_factory(const std::string& type) { return type.empty() ? nullptr : find(kMedia, type); }
+PhaseFactory find_phase_factory(const std::string& type) { return type.empty() ? nullptr : find(kPhases, type); }
 ShapeFactory find_shape_factory(const std::string& type) { return type.empty() ? nullptr : find(kShapes, type); }
 
 }  // namespace tessera

@@ -2,6 +2,8 @@
 // and the messages/unsupported items collected for the report.
 #include "tessera/scene/load_context.h"
 
+#include "tessera/core/check.h"
+
 #include "scene/builder_internal.h"
 
 #include <algorithm>
@@ -118,6 +120,53 @@ const Bsdf* LoadContext::bsdf(const std::shared_ptr<SceneNode>& node) {
   scene_.bsdfs.push_back(made);
   bsdfs_[key] = made.get();
   return made.get();
+}
+
+const Medium* LoadContext::medium(const std::shared_ptr<SceneNode>& node) {
+  TESSERA_CHECK(node != nullptr);
+  auto it = media_.find(node.get());
+  if (it != media_.end()) return it->second;
+  MediumFactory factory = find_medium_factory(node->type);
+  const Medium* out = nullptr;
+  if (factory) {
+    node->used = true;
+    std::shared_ptr<Medium> made = factory(*node, *this);
+    if (!made) throw SceneError(node->loc, "the medium plugin returned nothing");
+    scene_.media.push_back(made);
+    out = made.get();
+  }
+  media_[node.get()] = out;
+  return out;
+}
+
+std::shared_ptr<const PhaseFunction> LoadContext::phase(const SceneNode& medium_node) {
+  auto phases = medium_node.children_with_tag("phase");
+  if (phases.size() > 1) throw SceneError(phases[1]->loc, medium_node.describe() + " has more than one phase function");
+  if (!phases.empty()) {
+    const SceneNode& p = *phases[0];
+    if (PhaseFactory factory = find_phase_factory(p.type)) {
+      p.used = true;
+      std::shared_ptr<PhaseFunction> made = factory(p, *this);
+      if (!made) throw SceneError(p.loc, "the phase plugin returned nothing");
+      return made;
+    }
+    // Unsupported type: reported by the final walk; isotropic stands in.
+  }
+  return make_isotropic_phase();
+}
+
+const Bsdf* LoadContext::null_bsdf() {
+  if (!null_bsdf_) {
+    BsdfFactory factory = find_bsdf_factory("null");
+    TESSERA_CHECK(factory != nullptr);
+    SceneNode def;
+    def.tag = "bsdf";
+    def.type = "null";
+    std::shared_ptr<Bsdf> made = factory(def, *this);
+    scene_.bsdfs.push_back(made);
+    null_bsdf_ = made.get();
+  }
+  return null_bsdf_;
 }
 
 void LoadContext::note(const FileLoc& loc, const std::string& text) {

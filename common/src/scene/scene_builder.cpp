@@ -85,8 +85,8 @@ class ShapeBuilder {
  public:
   explicit ShapeBuilder(BuildState& st) : st_(st) {}
 
-  /// `parent_xf` is the instance transform for shapes inside a shapegroup (identity otherwise).
-  void build(const std::shared_ptr<SceneNode>& node_ptr, const Transform& parent_xf, bool in_group) {
+  /// `parent` is the instance transform for shapes inside a shapegroup (identity otherwise).
+  void build(const std::shared_ptr<SceneNode>& node_ptr, const AnimatedTransform& parent, bool in_group) {
     const SceneNode& node = *node_ptr;
     if (node.type == "instance") {
       build_instance(node);
@@ -99,13 +99,21 @@ class ShapeBuilder {
     if (cached == geometry_.end()) cached = geometry_.emplace(&node, make_geometry(node, factory)).first;
     const ShapeGeometry& g = cached->second;
 
-    Transform xf = parent_xf * node.get_transform("to_world", Transform());
+    // Motion blur (docs/scene-support.md): an <animation> to_world, an animated instance, or a
+    // sphere's center_close make the shape move over the shutter; it then keeps object-space
+    // geometry and `motion`. Without a shutter interval everything is placed at shutter_open.
+    AnimatedTransform anim = placement(node, parent, g);
+    const bool moving = !anim.is_static() && st_.scene.has_shutter_interval();
+    const Transform xf = anim.is_static() || !moving ? anim.at(st_.scene.shutter_open) : Transform();
     auto bsdfs = node.children_with_tag("bsdf");
     if (bsdfs.size() > 1) throw SceneError(bsdfs[1]->loc, node.describe() + " has more than one BSDF");
-    const Bsdf* bsdf = st_.ctx.bsdf(bsdfs.empty() ? nullptr : bsdfs[0]);
+    const ShapeMedia media = build_shape_media(st_, node);
+    const Bsdf* bsdf = bsdfs.empty() && media.any ? st_.ctx.null_bsdf() : st_.ctx.bsdf(bsdfs.empty() ? nullptr : bsdfs[0]);
 
     std::unique_ptr<Shape> shape;
-    if (g.is_sphere) {
+    if (g.is_sphere && moving) {
+      shape = std::make_unique<SphereShape>(g.center, g.radius, g.flip_normals);
+    } else if (g.is_sphere) {
       Vec3 center;
       float radius = 1.f;
       sphere_to_world(st_, node, xf, g, center, radius);
@@ -117,14 +125,25 @@ class ShapeBuilder {
         return;
       }
       bool analytic_normal = node.type == "rectangle" || node.type == "disk";
-      auto mesh = to_world_mesh(g.mesh, xf, analytic_normal && xf.swaps_handedness(), node);
+      // A moving mesh's normals come from the transform (as rectangle/disk's do); a mirroring
+      // animation re-winds the others so they turn inside out as their static form does.
+      auto mesh = moving ? to_world_mesh(g.mesh, Transform(), false, node) : to_world_mesh(g.mesh, xf, analytic_normal && xf.swaps_handedness(), node);
+      if (moving && !analytic_normal && anim.at(st_.scene.shutter_open).swaps_handedness()) {
+        auto rewound = std::make_shared<MeshData>(*mesh);
+        for (size_t t = 0; t + 2 < rewound->indices.size(); t += 3) std::swap(rewound->indices[t + 1], rewound->indices[t + 2]);
+        mesh = rewound;
+      }
       shape = std::make_unique<TriangleMeshShape>(std::move(mesh), g.flip_normals, g.face_normals);
     }
     shape->bsdf = bsdf;
+    shape->interior = media.interior;
+    shape->exterior = media.exterior;
+    shape->medium_interface = media.any;
     shape->name = node.describe();
     const Property* file = node.peek("filename");
     if (file && file->type == PropType::String) shape->name += " (" + file->s + ")";
-    attach_emitter(node, *shape, in_group);
+    if (moving) shape->motion = std::make_shared<const AnimatedTransform>(std::move(anim));
+    attach_emitter(node, *shape, in_group, moving);
     st_.scene.shapes.push_back(std::move(shape));
   }
 
@@ -146,7 +165,37 @@ class ShapeBuilder {
   BuildState& st_;
   std::map<const SceneNode*, ShapeGeometry> geometry_;  // a shapegroup member is loaded once
 
-  void attach_emitter(const SceneNode& node, Shape& shape, bool in_group) {
+  /// world_from_object over time: parent (instance) * to_world * (sphere) centre motion.
+  AnimatedTransform placement(const SceneNode& node, const AnimatedTransform& parent, const ShapeGeometry& g) {
+    const AnimatedTransform own = node.get_animated_transform("to_world", Transform());
+    const float t0 = st_.scene.shutter_open, t1 = st_.scene.shutter_close;
+    AnimatedTransform anim;
+    if (parent.is_static() && own.is_static()) {
+      anim = AnimatedTransform(parent.at(t0) * own.at(t0));  // exactly the static product
+    } else if (parent.is_static()) {
+      anim = own.composed(parent.at(t0), Transform());
+    } else if (own.is_static()) {
+      anim = parent.composed(Transform(), own.at(t0));
+    } else {
+      st_.ctx.unsupported(node.loc_of("to_world"), "an animated " + node.describe() + " inside an animated instance",
+                          "the shape's to_world at shutter_open");
+      anim = parent.composed(Transform(), own.at(t0));
+    }
+    // Tessera extension: a sphere's centre at shutter close (docs/plugins.md), linear in between.
+    const Property* cc = g.is_sphere ? node.find("center_close") : nullptr;
+    if (!cc) return anim;
+    const Vec3 c1 = node.get_vector("center_close", g.center);
+    if (!is_finite(c1)) throw SceneError(cc->loc, "center_close must be finite");
+    if (!(t1 > t0) || c1 == g.center) return anim;
+    if (!anim.is_static()) {
+      st_.ctx.unsupported(cc->loc, "center_close on a sphere whose to_world is animated", "the sphere stays at 'center'");
+      return anim;
+    }
+    AnimatedTransform slide({{t0, Transform()}, {t1, Transform::translate(c1 - g.center)}});
+    return slide.composed(anim.at(t0), Transform());
+  }
+
+  void attach_emitter(const SceneNode& node, Shape& shape, bool in_group, bool moving) {
     auto emitters = node.children_with_tag("emitter");
     if (emitters.size() > 1) throw SceneError(emitters[1]->loc, node.describe() + " has more than one emitter");
     if (emitters.empty()) return;
@@ -160,6 +209,11 @@ class ShapeBuilder {
     if (in_group) {
       if (st_.reported.insert(&e).second)
         st_.ctx.unsupported(e.loc, "area emitter inside a shapegroup (instanced emitters)", "dropped");
+      return;
+    }
+    if (moving) {
+      st_.ctx.unsupported(e.loc, "area emitter on a moving shape (" + node.describe() + ")", "dropped");
+      st_.reported.insert(&e);
       return;
     }
     e.used = true;
@@ -179,7 +233,7 @@ class ShapeBuilder {
       }
     if (!group) throw SceneError(node.loc, "an instance needs a <ref> to a shapegroup");
     group->used = true;
-    Transform xf = node.get_transform("to_world", Transform());
+    const AnimatedTransform xf = node.get_animated_transform("to_world", Transform());
     for (const auto& child : group->children) {
       if (child->tag != "shape") continue;  // anything else is reported by the final walk
       if (child->type == "shapegroup" || child->type == "instance")
@@ -194,7 +248,7 @@ class ShapeBuilder {
 void build_shapes(BuildState& st) {
   ShapeBuilder builder(st);
   for (const auto& c : st.desc.root->children)
-    if (c->tag == "shape" && c->type != "shapegroup") builder.build(c, Transform(), false);
+    if (c->tag == "shape" && c->type != "shapegroup") builder.build(c, AnimatedTransform(), false);
 }
 
 void build_emitters(BuildState& st) {
@@ -233,9 +287,11 @@ LoadResult load_scene(const SceneDesc& desc, const LoadOptions& options) {
   detail::BuildState st{ctx, desc, *scene, {}, {}};
   desc.root->used = true;
   detail::build_integrator(st);
+  detail::read_shutter(st);
   detail::build_shapes(st);
   detail::build_emitters(st);
   detail::build_sensor(st);
+  detail::finish_media(st);
   detail::report_unsupported(st);
   if (!options.allow_unsupported && !ctx.unsupported_items().empty())
     throw UnsupportedError(ctx.unsupported_items());

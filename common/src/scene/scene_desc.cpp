@@ -17,6 +17,7 @@ const char* type_name(PropType t) {
     case PropType::Color: return "a colour";
     case PropType::Vector: return "a point/vector";
     case PropType::Transform: return "a transform";
+    case PropType::Animation: return "an animated transform";
   }
   return "?";
 }
@@ -99,9 +100,21 @@ Vec3 SceneNode::get_vector(const std::string& n, Vec3 def) const {
 tessera::Transform SceneNode::get_transform(const std::string& n, const tessera::Transform& def) const {
   const Property* p = find(n);
   if (!p) return def;
+  if (p->type == PropType::Animation)
+    throw SceneError(p->loc, "parameter '" + p->written_name + "' of " + describe() +
+                                 " is animated (<animation>), which this plugin does not support");
   if (p->type != PropType::Transform) wrong_type(*this, *p, "a transform");
   p->used = true;
   return p->xf;
+}
+
+AnimatedTransform SceneNode::get_animated_transform(const std::string& n, const tessera::Transform& def) const {
+  const Property* p = find(n);
+  if (!p) return AnimatedTransform(def);
+  if (p->type != PropType::Transform && p->type != PropType::Animation)
+    wrong_type(*this, *p, "a transform or an animation");
+  p->used = true;
+  return p->type == PropType::Transform ? AnimatedTransform(p->xf) : AnimatedTransform(p->keyframes);
 }
 
 std::vector<std::shared_ptr<SceneNode>> SceneNode::children_with_tag(const std::string& t) const {

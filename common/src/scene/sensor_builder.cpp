@@ -9,6 +9,12 @@
 
 namespace tessera::detail {
 
+// sensor_camera.cpp: sensor types and their cameras.
+bool is_supported_sensor(const std::string& type);
+bool sensor_has_fov(const std::string& type);
+std::unique_ptr<Camera> make_sensor_camera(LoadContext& ctx, const SceneNode& sensor, const Transform& to_world,
+                                           float fov_x, const FilmSettings& film, float near_clip, float far_clip);
+
 namespace {
 
 constexpr double kPiD = 3.14159265358979323846;
@@ -212,6 +218,19 @@ void default_camera(BuildState& st) {
 
 }  // namespace
 
+namespace {
+
+// Mitsuba integrators Tessera does not implement whose image a path tracer converges to as well
+// (except for paths it cannot sample): rendered by the (volume) path tracer with a note.
+bool substituted_by_path_tracer(const std::string& type) {
+  static const char* const kTypes[] = {"bdpt", "pssmlt", "mlt", "erpt", "ppm", "sppm", "photonmapper", "ptracer", "vpl"};
+  for (const char* t : kTypes)
+    if (type == t) return true;
+  return false;
+}
+
+}  // namespace
+
 void build_integrator(BuildState& st) {
   auto nodes = st.desc.root->children_with_tag("integrator");
   report_extras(st, nodes, "integrator");
@@ -220,11 +239,10 @@ void build_integrator(BuildState& st) {
   // Mitsuba 0.x falls back to `direct` without an <integrator>; Mitsuba 2/3 to `path`.
   std::string type = node ? node->type : (st.desc.version_major < 2 ? "direct" : "path");
   IntegratorSettings& s = st.scene.integrator;
-  auto kind = [](const std::string& t) { return t == "volpath" ? std::string("path") : t; };
   if (!override_type.empty()) {
-    if (override_type != "path" && override_type != "direct")
-      throw SceneError("unknown integrator '" + override_type + "' (use path or direct)");
-    if (node && kind(node->type) != override_type) {
+    if (override_type != "path" && override_type != "volpath" && override_type != "direct")
+      throw SceneError("unknown integrator '" + override_type + "' (use path, volpath or direct)");
+    if (node && node->type != override_type) {
       st.ctx.note(node->loc, node->describe() + " replaced by the '" + override_type +
                                  "' integrator given on the command line; its parameters are ignored");
       st.reported.insert(node);
@@ -233,22 +251,28 @@ void build_integrator(BuildState& st) {
     type = override_type;
   }
   if (node) node->used = true;
-  if (kind(type) == "path") {
+  if (type == "path") {
     s.type = IntegratorType::Path;
+  } else if (type == "volpath") {
+    s.type = IntegratorType::VolPath;  // finish_media() makes it path when there are no media
   } else if (type == "direct") {
     s.type = IntegratorType::Direct;
+  } else if (substituted_by_path_tracer(type)) {
+    st.ctx.note(node->loc, node->describe() + " is rendered by Tessera's path tracer (volpath where the scene has media): "
+                               "the same expected image, except for light paths a path tracer cannot sample, "
+                               "such as caustics of point lights seen through specular surfaces");
+    st.params_exempt.insert(node);  // its own parameters (photon counts, mutations...) mean nothing here
+    s.type = IntegratorType::VolPath;
   } else {
     st.ctx.unsupported(node->loc, node->describe(), fallback_for(*node));
     st.reported.insert(node);
-    s.type = IntegratorType::Path;
+    s.type = IntegratorType::VolPath;
     return;
   }
   if (!node) return;
-  if (node->type == "volpath")
-    st.ctx.note(node->loc, "integrator 'volpath' is rendered by 'path' (the same without participating media)");
   s.hide_emitters = node->get_bool("hide_emitters", false);
   s.strict_normals = node->get_bool("strict_normals", false);
-  if (s.type == IntegratorType::Path) {
+  if (s.type != IntegratorType::Direct) {
     s.max_depth = int(get_int_in(*node, "max_depth", -1, -1, 1 << 20));
     s.rr_depth = int(get_int_in(*node, "rr_depth", 5, 1, 1 << 20));
   } else {
@@ -258,6 +282,20 @@ void build_integrator(BuildState& st) {
     if (s.emitter_samples + s.bsdf_samples == 0)
       throw SceneError(node->loc, "the direct integrator needs emitter_samples or bsdf_samples > 0");
   }
+}
+
+void read_shutter(BuildState& st) {
+  auto sensors = st.desc.root->children_with_tag("sensor");
+  if (sensors.empty()) return;
+  const SceneNode& sensor = *sensors[0];
+  // Mitsuba 0.6: both default to 0 (no motion blur); scene time is in the keyframes' units.
+  const float open = sensor.get_float("shutter_open", 0.f), close = sensor.get_float("shutter_close", open);
+  if (!std::isfinite(open) || !std::isfinite(close))
+    throw SceneError(prop_loc(sensor, "shutter_open"), "shutter times must be finite");
+  if (close < open)
+    throw SceneError(prop_loc(sensor, "shutter_close"), "shutter_close must not be before shutter_open");
+  st.scene.shutter_open = open;
+  st.scene.shutter_close = close;
 }
 
 void build_sensor(BuildState& st) {
@@ -271,18 +309,20 @@ void build_sensor(BuildState& st) {
     return;
   }
   sensor->used = true;
-  if (sensor->type != "perspective") {
+  if (!is_supported_sensor(sensor->type)) {
     st.ctx.unsupported(sensor->loc, sensor->describe(), fallback_for(*sensor));
     st.params_exempt.insert(sensor);
   }
   const FilmSettings& film = st.scene.film;
-  float fov_x = horizontal_fov(*sensor, double(film.width) / double(film.height));
-  if (!(fov_x > 0.f && fov_x < 180.f)) throw SceneError(sensor->loc, "the field of view degenerates at this aspect ratio");
+  const bool has_fov = sensor_has_fov(sensor->type);
+  float fov_x = has_fov ? horizontal_fov(*sensor, double(film.width) / double(film.height)) : 0.f;
+  if (has_fov && !(fov_x > 0.f && fov_x < 180.f))
+    throw SceneError(sensor->loc, "the field of view degenerates at this aspect ratio");
   float near_clip = sensor->get_float("near_clip", 1e-2f), far_clip = sensor->get_float("far_clip", 1e4f);
   if (!(near_clip > 0.f) || !(far_clip > near_clip))
     throw SceneError(prop_loc(*sensor, "near_clip"), "clip distances must satisfy 0 < near_clip < far_clip");
   Transform to_world = sensor->get_transform("to_world", Transform());
-  st.scene.camera = make_perspective_camera(to_world, fov_x, film.width, film.height, near_clip, far_clip);
+  st.scene.camera = make_sensor_camera(st.ctx, *sensor, to_world, fov_x, film, near_clip, far_clip);
 }
 
 }  // namespace tessera::detail

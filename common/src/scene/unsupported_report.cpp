@@ -100,6 +100,8 @@ bool plugin_supported(const SceneNode& node, const SceneNode* parent) {
   if (node.tag == "texture") return find_texture_factory(t) != nullptr;
   if (node.tag == "shape") return t == "instance" || t == "shapegroup" || find_shape_factory(t) != nullptr;
   if (node.tag == "emitter") return t == "area" ? (parent && parent->tag == "shape") : find_light_factory(t) != nullptr;
+  if (node.tag == "medium") return find_medium_factory(t) != nullptr;
+  if (node.tag == "phase") return find_phase_factory(t) != nullptr;
   // Builders decide these themselves and report unsupported types directly.
   return node.tag == "sensor" || node.tag == "film" || node.tag == "sampler" || node.tag == "rfilter" ||
          node.tag == "integrator" || node.tag == "scene";
@@ -179,6 +181,8 @@ std::string fallback_for(const SceneNode& node) {
     return buf;
   }
   if (tag == "emitter") return "dropped";
+  if (tag == "medium") return "ignored (vacuum)";
+  if (tag == "phase") return "isotropic";
   if (tag == "shape") return "skipped";
   if (tag == "sensor") return "pinhole perspective camera with its to_world and fov";
   if (tag == "integrator") return "path";

@@ -245,8 +245,11 @@ class Parser {
       parse_object(src, el, attrs, parent, depth);
       return;
     }
-    if (tag == "atransform" || tag == "animation")
-      throw SceneError(loc, "animated transforms (<" + tag + ">) are not supported");
+    if (tag == "animation") {
+      parse_property(src, el, tag, attrs, loc, parent);
+      return;
+    }
+    if (tag == "atransform") throw SceneError(loc, "<atransform> is not supported (use <animation>)");
     throw SceneError(loc, "unknown element <" + tag + ">");
   }
 
@@ -273,10 +276,43 @@ class Parser {
       if (!xf) throw SceneError(loc, "transform " + squote(prop.written_name) + " is singular or not finite");
       prop.type = PropType::Transform;
       prop.xf = *xf;
+    } else if (tag == "animation") {
+      attrs.check_allowed({"name"}, tag, loc);
+      parse_animation(src, el, prop);
     } else if (!xml::parse_value_property(tag, attrs, loc, base_dir_, prop)) {
       throw SceneError(loc, "unknown element <" + tag + ">");
     }
     parent.props.push_back(std::move(prop));
+  }
+
+  /// Mitsuba 0.6: <animation name=..> holds <transform time=".."> keyframes, strictly increasing.
+  void parse_animation(Source& src, const pugi::xml_node& el, Property& prop) {
+    for (pugi::xml_node key : el.children()) {
+      if (key.type() != pugi::node_element) continue;
+      const FileLoc kloc = src.loc(key);
+      if (std::string_view(key.name()) != "transform")
+        throw SceneError(kloc, "<animation> holds <transform time=..> keyframes, not <" + std::string(key.name()) + ">");
+      Attrs kattrs = attrs_of(src, key);
+      kattrs.check_allowed({"time"}, "transform", kloc);
+      const double time = xml::parse_double(kattrs.require("time", "transform", kloc), kloc, "keyframe time");
+      Matrix4 m = Matrix4::identity();
+      for (pugi::xml_node child : key.children()) {
+        if (child.type() != pugi::node_element) continue;
+        m = xml::parse_transform_element(child.name(), attrs_of(src, child), src.loc(child)) * m;
+      }
+      auto xf = Transform::from_matrix(m);
+      if (!xf) throw SceneError(kloc, "keyframe of " + squote(prop.written_name) + " is singular or not finite");
+      if (m.m[3][0] != 0 || m.m[3][1] != 0 || m.m[3][2] != 0 || m.m[3][3] != 1)
+        throw SceneError(kloc, "keyframe of " + squote(prop.written_name) + " is projective; keyframes must be affine");
+      if (!prop.keyframes.empty() && !(float(time) > prop.keyframes.back().time))
+        throw SceneError(kloc, "keyframe times of " + squote(prop.written_name) + " must increase strictly (" +
+                                   std::to_string(time) + " after " + std::to_string(prop.keyframes.back().time) + ")");
+      prop.keyframes.push_back({float(time), *xf});
+    }
+    if (prop.keyframes.empty())
+      throw SceneError(prop.loc, "<animation> " + squote(prop.written_name) + " has no <transform time=..> keyframes");
+    prop.type = PropType::Animation;
+    prop.xf = prop.keyframes.front().xf;
   }
 
   void parse_object(Source& src, const pugi::xml_node& el, const Attrs& attrs, SceneNode& parent, int depth) {

@@ -20,6 +20,7 @@ struct RenderOptions {
   uint32_t seed = 0;
   std::map<std::string, std::string> defines;
   std::string integrator;                  // empty: as the scene says
+  std::string light_selection;             // "power" or "bvh"; empty: the default (bvh)
   bool allow_unsupported = false;
   bool quiet = false;
 };

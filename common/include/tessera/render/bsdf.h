@@ -43,6 +43,11 @@ class Bsdf {
   /// (Scene::intersect), and shadow rays are attenuated by 1 - opacity (Scene::transmittance).
   /// So eval()/pdf()/sample() of a masked BSDF describe the opaque part only.
   virtual float opacity(const SurfaceInteraction&) const { return 1.f; }
+  /// True for Mitsuba's `null` BSDF: an index-matched boundary (the surface of a medium) that rays
+  /// cross unchanged. It has opacity 0, so an integrator that does not track media, and every
+  /// shadow ray, passes it like a fully transparent mask; the volume path tracer stops there to
+  /// switch media (Scene::intersect with `stop_at_null`).
+  virtual bool is_null() const { return false; }
 };
 
 }  // namespace tessera

@@ -44,6 +44,12 @@ class Camera {
   virtual ~Camera() = default;
   /// Ray through raster position `raster` (see above); `u_lens` for depth of field. Direction unit.
   virtual Ray generate_ray(Vec2 raster, Vec2 u_lens) const = 0;
+  /// The ray at scene time `time` (motion blur); a camera that does not move just stamps the time.
+  virtual Ray generate_ray_at(Vec2 raster, Vec2 u_lens, float time) const {
+    Ray r = generate_ray(raster, u_lens);
+    r.time = time;
+    return r;
+  }
 };
 
 /// Mitsuba's perspective sensor: looks down +z of `world_from_camera` with +y up, image x mirrored
@@ -52,5 +58,20 @@ class Camera {
 std::unique_ptr<Camera> make_perspective_camera(const Transform& world_from_camera, float fov_x_degrees,
                                                 int film_width, int film_height, float near_clip,
                                                 float far_clip);
+
+/// Mitsuba's `thinlens` sensor: the perspective camera above with a thin lens of radius
+/// `aperture_radius` in the camera's z = 0 plane, sampled with the concentric disk map from
+/// `u_lens`; every ray of a raster position passes through the pinhole ray's point on the focus
+/// plane z = focus_distance (camera space), so that plane is sharp. aperture_radius 0: a pinhole.
+std::unique_ptr<Camera> make_thinlens_camera(const Transform& world_from_camera, float fov_x_degrees,
+                                             int film_width, int film_height, float near_clip, float far_clip,
+                                             float aperture_radius, float focus_distance);
+
+/// Mitsuba's `orthographic` sensor: rays along camera +z from the z = 0 plane, camera-space
+/// x in [-1, 1] across the film width and y in [-1/aspect, 1/aspect] (aspect = width / height)
+/// across its height, x mirrored as in the perspective camera. The extent comes from the scale in
+/// `world_from_camera`; the clip distances are along the (unit) world direction.
+std::unique_ptr<Camera> make_orthographic_camera(const Transform& world_from_camera, int film_width,
+                                                 int film_height, float near_clip, float far_clip);
 
 }  // namespace tessera

@@ -15,8 +15,12 @@
 #include "tessera/render/interaction.h"
 
 #include <cstdint>
+#include <memory>
+#include <vector>
 
 namespace tessera {
+
+struct LightBounds;  // light/light_bounds.h
 
 struct LightSample {
   Rgb li;               // incident radiance along -wi arriving at the reference point
@@ -57,8 +61,20 @@ class Light {
   /// Total emitted power (an estimate is fine); lights are picked in proportion to it.
   virtual float power() const = 0;
 
-  /// Position in Scene::lights, set by Scene::finalize() (light selection looks it up there).
+  /// Light hierarchies: where and in which directions this light emits (light/light_bounds.h).
+  /// False for lights that cannot say (infinite ones); those are picked with a fixed probability.
+  virtual bool light_bounds(LightBounds& out) const { return false; }
+  /// Area lights on triangle meshes: one light per primitive of the shape, in primitive order, to
+  /// replace this one for light selection (Scene::finalize does it; Shape::prim_lights maps hits
+  /// to them). Empty for lights that stay whole.
+  virtual std::vector<std::unique_ptr<Light>> make_primitive_lights() const { return {}; }
+
+  /// Position in Scene::lights, set by Scene::finalize() (per-primitive lights: their emitter's).
   uint32_t scene_index = 0;
+  /// Position among the lights that light selection chooses from (LightSampler::lights()), set
+  /// by Scene::finalize(); kNotSelectable for an emitter replaced by its per-primitive lights.
+  static constexpr uint32_t kNotSelectable = 0xFFFFFFFFu;
+  uint32_t selection_index = kNotSelectable;
 };
 
 }  // namespace tessera

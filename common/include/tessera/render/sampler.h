@@ -9,6 +9,12 @@
 //   per bounce:  light pick 1D, light position 2D, BSDF lobe 1D, BSDF direction 2D, Russian
 //                roulette 1D  (7 dimensions per bounce, always consumed in this order so that a
 //                given dimension means the same thing in every path)
+//   volpath:     on a scene with media, each ray segment first takes a medium 2D (channel,
+//                distance); a scattering point in a medium then takes the same 7 dimensions as a
+//                surface bounce (the lobe dimension unused, the phase direction in the BSDF's 2D)
+// time:        only when the shutter is open for a non-zero interval (motion blur), the camera ray's
+//              time from dimension kTimeDimension, read with sample_1d_at() so the counter, and
+//              thus every dimension above, is the same as without motion blur
 // The direct integrator uses, per hit, (1D + 2D) per emitter sample then (1D + 2D) per BSDF sample.
 //
 // Types:
@@ -36,6 +42,18 @@ class Sampler {
   float next_1d();
   /// Uniform in [0, 1)^2.
   Vec2 next_2d();
+
+  /// The value next_1d() would return at dimension `dim`, leaving the counter where it is: for
+  /// dedicated dimensions outside the sequential layout (kTimeDimension).
+  float sample_1d_at(uint32_t dim) {
+    const uint32_t saved = dim_;
+    dim_ = dim;
+    const float u = next_1d();
+    dim_ = saved;
+    return u;
+  }
+  /// Far above any sequential dimension a path reaches.
+  static constexpr uint32_t kTimeDimension = 0xFFFFFF00u;
 
   uint32_t dimension() const { return dim_; }
   SamplerType type() const { return type_; }

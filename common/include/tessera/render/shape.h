@@ -21,8 +21,10 @@
 
 namespace tessera {
 
+class AnimatedTransform;
 class Bsdf;
 class Light;
+class Medium;
 
 /// Triangle mesh data as loaders produce it (object space) and as shapes keep it (world space).
 struct MeshData {
@@ -57,6 +59,18 @@ class Shape {
 
   const Bsdf* bsdf = nullptr;
   const Light* light = nullptr;  // area light attached to this shape, if any
+  // Per-primitive lights that replace `light` for sampling and MIS (an emissive mesh split into
+  // triangle lights by Scene::finalize); empty when `light` stays whole.
+  std::vector<const Light*> prim_lights;
+  /// The light a hit on primitive `prim` sees (SurfaceInteraction::area_light()).
+  const Light* area_light(uint32_t prim) const { return prim < prim_lights.size() ? prim_lights[prim] : light; }
+  // Participating media on either side (null: vacuum); see medium_after() in scene.h.
+  const Medium* interior = nullptr;
+  const Medium* exterior = nullptr;
+  bool medium_interface = false;  // the scene gave this shape an interior or exterior medium
+  // Set for a moving shape (motion blur): its geometry is then in OBJECT space and this places it
+  // in the world at each time (render/motion.h). Null: world-space geometry, as everywhere else.
+  std::shared_ptr<const AnimatedTransform> motion;
   std::string name;              // for messages: "shape 'obj' (models/Mesh001.obj)"
 };
 

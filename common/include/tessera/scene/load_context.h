@@ -68,6 +68,13 @@ class LoadContext {
   /// An unsupported type yields the documented fallback (diffuse 0.5 / constant texture); the
   /// final report lists it.
   const Bsdf* bsdf(const std::shared_ptr<SceneNode>& node);
+  /// Builds (once per node, owned by the scene) the medium a shape or sensor refers to. Null when
+  /// the type is unsupported (reported by the final walk: the medium is then ignored).
+  const Medium* medium(const std::shared_ptr<SceneNode>& node);
+  /// The phase function nested in (or referenced by) a medium node; isotropic when none is.
+  std::shared_ptr<const PhaseFunction> phase(const SceneNode& medium_node);
+  /// The singleton `null` BSDF for shapes that bound a medium without a BSDF of their own.
+  const Bsdf* null_bsdf();
 
   void note(const FileLoc& loc, const std::string& text);
   void warn(const FileLoc& loc, const std::string& text);
@@ -86,6 +93,8 @@ class LoadContext {
   std::vector<UnsupportedItem> unsupported_;
   std::map<const SceneNode*, std::shared_ptr<Texture>> textures_;
   std::map<const SceneNode*, const Bsdf*> bsdfs_;
+  std::map<const SceneNode*, const Medium*> media_;
+  const Bsdf* null_bsdf_ = nullptr;
   std::map<std::string, std::shared_ptr<const MeshData>> meshes_;
   std::map<std::string, std::shared_ptr<const Image>> images_;
 };
@@ -93,8 +102,12 @@ class LoadContext {
 using BsdfFactory = std::shared_ptr<Bsdf> (*)(const SceneNode&, LoadContext&);
 using TextureFactory = std::shared_ptr<Texture> (*)(const SceneNode&, LoadContext&);
 /// A light factory for lights that stand alone (point, constant, envmap). Area lights are made by
-/// the shape loader, which knows the shape.
+/// the shape loader, which knows the shape. A node that stands for more than one light (`sunsky`
+/// with sunRadiusScale = 0: sky map + directional sun) adds the extra ones to ctx.scene().lights
+/// itself and returns the main one.
 using LightFactory = std::unique_ptr<Light> (*)(const SceneNode&, LoadContext&);
+using MediumFactory = std::shared_ptr<Medium> (*)(const SceneNode&, LoadContext&);
+using PhaseFactory = std::shared_ptr<PhaseFunction> (*)(const SceneNode&, LoadContext&);
 /// Shape factories return object-space meshes or a sphere description; the builder applies
 /// `to_world`, attaches BSDF and area light.
 struct ShapeGeometry {
@@ -115,8 +128,11 @@ std::unique_ptr<Light> make_area_light(const SceneNode& emitter, LoadContext& ct
 BsdfFactory find_bsdf_factory(const std::string& type);
 TextureFactory find_texture_factory(const std::string& type);
 LightFactory find_light_factory(const std::string& type);
+MediumFactory find_medium_factory(const std::string& type);
+PhaseFactory find_phase_factory(const std::string& type);
 ShapeFactory find_shape_factory(const std::string& type);
-/// Plugin types of one factory table ("bsdf", "texture", "shape", "emitter"), in table order.
+/// Plugin types of one factory table ("bsdf", "texture", "shape", "emitter", "medium", "phase"), in
+/// table order.
 std::vector<std::string> registered_plugins(const std::string& tag);
 
 struct LoadResult {

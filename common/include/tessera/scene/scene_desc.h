@@ -4,6 +4,7 @@
 // anything left unconsumed can be reported as unsupported.
 #pragma once
 
+#include "tessera/core/animated_transform.h"
 #include "tessera/core/rgb.h"
 #include "tessera/core/transform.h"
 #include "tessera/core/vec.h"
@@ -18,7 +19,8 @@
 
 namespace tessera {
 
-enum class PropType { Boolean, Integer, Float, String, Color, Vector, Transform };
+// Animation: Mitsuba 0.6's <animation name=..> of <transform time=..> keyframes (motion blur).
+enum class PropType { Boolean, Integer, Float, String, Color, Vector, Transform, Animation };
 
 /// One `<float name=.. value=..>`-like entry. Names are normalised to Mitsuba 3's snake_case
 /// (`toWorld` -> `to_world`, `maxDepth` -> `max_depth`); `written_name` keeps the spelling used.
@@ -33,7 +35,8 @@ struct Property {
   std::string s;
   Rgb color;       // <rgb>, <srgb> (linearised), <spectrum> (reduced to RGB), <blackbody>
   Vec3 v;          // <point>, <vector>
-  tessera::Transform xf;
+  tessera::Transform xf;  // for an Animation: its first keyframe
+  std::vector<AnimatedTransform::Keyframe> keyframes;  // Animation only: strictly increasing times
   mutable bool used = false;
 };
 
@@ -57,13 +60,22 @@ struct SceneNode {
   /// find() for messages: not logged as a parameter the plugin reads (scene/parameter_log.h).
   const Property* peek(const std::string& name) const;
   bool has(const std::string& name) const { return find(name) != nullptr; }
+  /// Where parameter `name` was written (the node's own location when absent), for errors.
+  FileLoc loc_of(const std::string& name) const {
+    const Property* p = peek(name);
+    return p ? p->loc : loc;
+  }
   float get_float(const std::string& name, float def) const;
   int64_t get_int(const std::string& name, int64_t def) const;
   bool get_bool(const std::string& name, bool def) const;
   std::string get_string(const std::string& name, const std::string& def) const;
   Rgb get_color(const std::string& name, Rgb def) const;  // accepts a float as grey
   Vec3 get_vector(const std::string& name, Vec3 def) const;
+  /// An <animation> here is an error naming the node: only plugins that call
+  /// get_animated_transform() support moving.
   tessera::Transform get_transform(const std::string& name, const tessera::Transform& def) const;
+  /// A <transform> (static) or an <animation> (keyframes).
+  AnimatedTransform get_animated_transform(const std::string& name, const tessera::Transform& def) const;
 
   /// Children with the given tag, in document order.
   std::vector<std::shared_ptr<SceneNode>> children_with_tag(const std::string& tag) const;
