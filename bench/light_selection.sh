@@ -2,18 +2,18 @@
 # Light selection at equal time: for the many-lights scene and staircase2, renders with power
 # (alias table) and bvh (light hierarchy) selection, each with the spp that fills the same render
 # time (from a short calibration render), and reports render seconds, spp and relMSE against a
-# reference. staircase2: ../shared/references/staircase2/reference.exr (it includes the medium,
-# which `path` ignores: its relMSE has a floor from that). many-lights: a high-spp bvh render made
-# once with another seed and cached in BUILD/bench-cache/ (delete it to remake it).
+# reference. staircase2: ../shared/references/staircase2/reference.exr (rendered with volpath, the
+# scene's own integrator). many-lights: a high-spp bvh render made once with another seed and cached
+# in BUILD/bench-cache/ (delete it to remake it).
 # Usage: bench/light_selection.sh [BUILD_DIR] [THREADS] [SECONDS_PER_RENDER] [REF_SPP]
-# Env: INTEGRATOR (default path), SCENES (default "many-lights staircase2").
+# Env: INTEGRATOR (default: each scene's own), SCENES (default "many-lights staircase2").
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build}
 threads=${2:-$(nproc)}
 budget=${3:-20}
 ref_spp=${4:-4096}
-integrator=${INTEGRATOR:-path}
+integrator=${INTEGRATOR:-}
 read -r -a scenes <<< "${SCENES:-many-lights staircase2}"
 tessera="$build/cli/tessera"
 cache="$build/bench-cache"
@@ -27,13 +27,13 @@ scene_path() { [ "$1" = many-lights ] && echo scenes/many-lights/scene.xml || ec
 render() {
   local log="$out/log.txt"
   "$tessera" render "$(scene_path "$1")" -o "$5" --width 320 --height 180 --spp "$3" --seed "$4" \
-    --threads "$threads" --integrator "$integrator" --light-selection "$2" --allow-unsupported -q 2>"$log"
+    --threads "$threads" ${integrator:+--integrator "$integrator"} --light-selection "$2" --allow-unsupported -q 2>"$log"
   sed -n 's/.*render \([0-9.]*\) s$/\1/p' "$log"
 }
 
 for s in "${scenes[@]}"; do
   if [ "$s" = many-lights ]; then
-    ref="$cache/many-lights-ref-$integrator-$ref_spp.exr"
+    ref="$cache/many-lights-ref-${integrator:-own}-$ref_spp.exr"
     if [ ! -f "$ref" ]; then
       echo "making the many-lights reference ($ref_spp spp, bvh, seed 777): $ref" >&2
       t=$(render many-lights bvh "$ref_spp" 777 "$ref")

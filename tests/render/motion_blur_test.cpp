@@ -21,12 +21,14 @@ constexpr float kRadius = 0.4f, kX0 = -1.2f, kX1 = 0.8f;  // sphere centre x at 
 // A black sphere in front of a constant environment of radiance 1, seen directly (maxDepth 1):
 // a pixel's value is 1 - (fraction of the shutter the sphere covers its centre). The box filter
 // of radius 1e-4 keeps every sample at the pixel centre.
-std::string scene_xml(const std::string& sphere, float shutter_close) {
+const std::string kStaticCamera = R"(<transform name="toWorld"><scale x="2" y="2"/></transform>)";
+
+std::string scene_xml(const std::string& sphere, float shutter_close, const std::string& camera = kStaticCamera) {
   return R"(<scene version="0.6.0">
     <integrator type="path"><integer name="maxDepth" value="1"/></integrator>
     <sensor type="orthographic">
       <float name="shutterOpen" value="0"/><float name="shutterClose" value=")" + std::to_string(shutter_close) + R"("/>
-      <transform name="toWorld"><scale x="2" y="2"/></transform>
+      )" + camera + R"(
       <sampler type="independent"><integer name="sampleCount" value=")" + std::to_string(kSpp) + R"("/></sampler>
       <film type="hdrfilm"><integer name="width" value="64"/><integer name="height" value="16"/>
         <rfilter type="box"><float name="radius" value="0.0001"/></rfilter></film>
@@ -95,6 +97,18 @@ TEST(MotionBlur, AnimatedToWorldMatchesTheAnalyticFraction) {
         <transform time="1"><translate x="0.8" y="0" z="5"/></transform>
       </animation><ref id="black"/></shape>)";
   expect_analytic_coverage(render_xml(scene_xml(sphere, 1.f)));
+}
+
+// The camera moving the other way past a still sphere: the same relative motion, so the same
+// analytic coverage (camera x from 1.2 to -0.8 while the sphere stays at x = 0).
+TEST(MotionBlur, AnimatedCameraMatchesTheAnalyticFraction) {
+  const std::string still = R"(<shape type="sphere"><float name="radius" value="0.4"/>
+      <point name="center" x="0" y="0" z="5"/><ref id="black"/></shape>)";
+  const std::string moving_camera = R"(<animation name="toWorld">
+        <transform time="0"><scale x="2" y="2"/><translate x="1.2"/></transform>
+        <transform time="1"><scale x="2" y="2"/><translate x="-0.8"/></transform>
+      </animation>)";
+  expect_analytic_coverage(render_xml(scene_xml(still, 1.f, moving_camera)));
 }
 
 // The same motion through an animated instance of a shapegroup gives the same bits as the shape's

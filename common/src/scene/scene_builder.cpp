@@ -20,11 +20,6 @@ namespace detail {
 
 namespace {
 
-FileLoc prop_loc(const SceneNode& node, const char* name) {
-  const Property* p = node.find(name);
-  return p ? p->loc : node.loc;
-}
-
 std::shared_ptr<const MeshData> to_world_mesh(const std::shared_ptr<const MeshData>& mesh, const Transform& xf,
                                               bool rewind, const SceneNode& node) {
   if (xf.is_identity()) return mesh;
@@ -32,7 +27,7 @@ std::shared_ptr<const MeshData> to_world_mesh(const std::shared_ptr<const MeshDa
   w.positions.reserve(mesh->positions.size());
   for (Vec3 p : mesh->positions) {
     Vec3 q = xf.apply_point(p);
-    if (!is_finite(q)) throw SceneError(prop_loc(node, "to_world"), "to_world maps a vertex to a non-finite position");
+    if (!is_finite(q)) throw SceneError(node.loc_of("to_world"), "to_world maps a vertex to a non-finite position");
     w.positions.push_back(q);
   }
   w.normals.reserve(mesh->normals.size());
@@ -72,13 +67,13 @@ void sphere_to_world(BuildState& st, const SceneNode& node, const Transform& xf,
     double det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
                  a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
     s = std::cbrt(std::abs(det));
-    st.ctx.unsupported(prop_loc(node, "to_world"),
+    st.ctx.unsupported(node.loc_of("to_world"),
                        "non-uniform scale, shear or projection in to_world of " + node.describe(),
                        "a sphere of the same volume (radius scaled by cbrt|det|)");
   }
   radius = float(double(g.radius) * s);
   if (!is_finite(center) || !(radius > 0.f) || !std::isfinite(radius))
-    throw SceneError(prop_loc(node, "to_world"), "to_world makes the sphere degenerate or non-finite");
+    throw SceneError(node.loc_of("to_world"), "to_world makes the sphere degenerate or non-finite");
 }
 
 class ShapeBuilder {

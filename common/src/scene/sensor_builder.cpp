@@ -21,15 +21,10 @@ constexpr double kPiD = 3.14159265358979323846;
 constexpr int64_t kMaxFilmSize = 1 << 15;   // pixels per side; keeps width*height well inside int
 constexpr int64_t kMaxSamples = 1 << 24;    // per pixel
 
-FileLoc prop_loc(const SceneNode& node, const char* name) {
-  const Property* p = node.find(name);
-  return p ? p->loc : node.loc;
-}
-
 int64_t get_int_in(const SceneNode& node, const char* name, int64_t def, int64_t lo, int64_t hi) {
   int64_t v = node.get_int(name, def);
   if (v < lo || v > hi)
-    throw SceneError(prop_loc(node, name), "'" + std::string(name) + "' of " + node.describe() + " must be in [" +
+    throw SceneError(node.loc_of(name), "'" + std::string(name) + "' of " + node.describe() + " must be in [" +
                                                std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
                                                std::to_string(v));
   return v;
@@ -61,14 +56,14 @@ std::shared_ptr<const Filter> build_filter(BuildState& st, const SceneNode* film
   node->used = true;
   auto radius = [&](float def) {
     float r = node->get_float("radius", def);
-    if (!(r > 0.f) || r > 100.f) throw SceneError(prop_loc(*node, "radius"), "filter radius must be in (0, 100]");
+    if (!(r > 0.f) || r > 100.f) throw SceneError(node->loc_of("radius"), "filter radius must be in (0, 100]");
     return r;
   };
   if (node->type == "box") return make_box_filter(radius(0.5f));
   if (node->type == "tent") return make_tent_filter(radius(1.f));
   if (node->type == "gaussian") {
     float stddev = node->get_float("stddev", 0.5f);
-    if (!(stddev > 0.f) || stddev > 25.f) throw SceneError(prop_loc(*node, "stddev"), "stddev must be in (0, 25]");
+    if (!(stddev > 0.f) || stddev > 25.f) throw SceneError(node->loc_of("stddev"), "stddev must be in (0, 25]");
     return make_gaussian_filter(stddev, 4.f * stddev);  // Mitsuba truncates at 4 standard deviations
   }
   st.ctx.unsupported(node->loc, node->describe(), fallback_for(*node));
@@ -98,12 +93,12 @@ FilmSettings build_film(BuildState& st, const SceneNode* sensor) {
       film.ldr = true;
       film.gamma = node->get_float("gamma", -1.f);
       if (!(film.gamma == -1.f || (film.gamma > 0.f && film.gamma <= 10.f)))
-        throw SceneError(prop_loc(*node, "gamma"), "ldrfilm gamma must be -1 (sRGB) or in (0, 10]");
+        throw SceneError(node->loc_of("gamma"), "ldrfilm gamma must be -1 (sRGB) or in (0, 10]");
       film.exposure = node->get_float("exposure", 0.f);
-      if (std::abs(film.exposure) > 100.f) throw SceneError(prop_loc(*node, "exposure"), "exposure out of range");
+      if (std::abs(film.exposure) > 100.f) throw SceneError(node->loc_of("exposure"), "exposure out of range");
       std::string method = lower(node->get_string("tonemap_method", "gamma"));
       if (method != "gamma")
-        st.ctx.unsupported(prop_loc(*node, "tonemap_method"), "tonemap_method '" + method + "' of " + node->describe(),
+        st.ctx.unsupported(node->loc_of("tonemap_method"), "tonemap_method '" + method + "' of " + node->describe(),
                            "gamma tonemapping");
     }
   }
@@ -159,7 +154,7 @@ float horizontal_fov(const SceneNode& sensor, double aspect) {
   FileLoc loc = sensor.loc;
   if (sensor.has("fov")) {
     fov = sensor.get_float("fov", 0.f);
-    loc = prop_loc(sensor, "fov");
+    loc = sensor.loc_of("fov");
     axis = lower(sensor.get_string("fov_axis", "x"));
   } else {
     // 35 mm film equivalent focal length, "50mm" by default; it fixes the diagonal.
@@ -191,7 +186,7 @@ float horizontal_fov(const SceneNode& sensor, double aspect) {
   else if (axis == "diagonal")
     tx = t / std::sqrt(1.0 + 1.0 / (aspect * aspect));
   else
-    throw SceneError(prop_loc(sensor, "fov_axis"), "fov_axis must be x, y, diagonal, smaller or larger, not '" + axis + "'");
+    throw SceneError(sensor.loc_of("fov_axis"), "fov_axis must be x, y, diagonal, smaller or larger, not '" + axis + "'");
   return float(deg(2.0 * std::atan(tx)));
 }
 
@@ -291,9 +286,9 @@ void read_shutter(BuildState& st) {
   // Mitsuba 0.6: both default to 0 (no motion blur); scene time is in the keyframes' units.
   const float open = sensor.get_float("shutter_open", 0.f), close = sensor.get_float("shutter_close", open);
   if (!std::isfinite(open) || !std::isfinite(close))
-    throw SceneError(prop_loc(sensor, "shutter_open"), "shutter times must be finite");
+    throw SceneError(sensor.loc_of("shutter_open"), "shutter times must be finite");
   if (close < open)
-    throw SceneError(prop_loc(sensor, "shutter_close"), "shutter_close must not be before shutter_open");
+    throw SceneError(sensor.loc_of("shutter_close"), "shutter_close must not be before shutter_open");
   st.scene.shutter_open = open;
   st.scene.shutter_close = close;
 }
@@ -320,9 +315,14 @@ void build_sensor(BuildState& st) {
     throw SceneError(sensor->loc, "the field of view degenerates at this aspect ratio");
   float near_clip = sensor->get_float("near_clip", 1e-2f), far_clip = sensor->get_float("far_clip", 1e4f);
   if (!(near_clip > 0.f) || !(far_clip > near_clip))
-    throw SceneError(prop_loc(*sensor, "near_clip"), "clip distances must satisfy 0 < near_clip < far_clip");
-  Transform to_world = sensor->get_transform("to_world", Transform());
+    throw SceneError(sensor->loc_of("near_clip"), "clip distances must satisfy 0 < near_clip < far_clip");
+  // An animated camera is built at shutter open and moved per ray; without a shutter interval (or
+  // with equal keyframes) it stands still there, as animated shapes do.
+  const AnimatedTransform motion = sensor->get_animated_transform("to_world", Transform());
+  const Transform to_world = motion.at(st.scene.shutter_open);
   st.scene.camera = make_sensor_camera(st.ctx, *sensor, to_world, fov_x, film, near_clip, far_clip);
+  if (!motion.is_static() && st.scene.shutter_close > st.scene.shutter_open)
+    st.scene.camera = make_animated_camera(std::move(st.scene.camera), to_world, motion);
 }
 
 }  // namespace tessera::detail

@@ -11,11 +11,6 @@ namespace tessera {
 
 namespace {
 
-FileLoc prop_loc(const SceneNode& node, const char* name) {
-  const Property* p = node.find(name);
-  return p ? p->loc : node.loc;
-}
-
 std::string required_filename(const SceneNode& node) {
   std::string file = node.get_string("filename", "");
   if (file.empty()) throw SceneError(node.loc, node.describe() + " needs a 'filename'");
@@ -56,7 +51,7 @@ ShapeGeometry analytic(const SceneNode& node, LoadContext& ctx, const char* name
 
 ShapeGeometry make_obj(const SceneNode& node, LoadContext& ctx) {
   std::string file = required_filename(node);
-  FileLoc loc = prop_loc(node, "filename");
+  FileLoc loc = node.loc_of("filename");
   std::string path = ctx.resolve_path(file, loc);
   ObjOptions opt;
   opt.face_normals = node.get_bool("face_normals", false);
@@ -71,7 +66,7 @@ ShapeGeometry make_obj(const SceneNode& node, LoadContext& ctx) {
 
 ShapeGeometry make_ply(const SceneNode& node, LoadContext& ctx) {
   std::string file = required_filename(node);
-  FileLoc loc = prop_loc(node, "filename");
+  FileLoc loc = node.loc_of("filename");
   std::string path = ctx.resolve_path(file, loc);
   bool fn = node.get_bool("face_normals", false);
   bool flip = node.get_bool("flip_normals", false);
@@ -82,11 +77,11 @@ ShapeGeometry make_ply(const SceneNode& node, LoadContext& ctx) {
 
 ShapeGeometry make_serialized(const SceneNode& node, LoadContext& ctx) {
   std::string file = required_filename(node);
-  FileLoc loc = prop_loc(node, "filename");
+  FileLoc loc = node.loc_of("filename");
   std::string path = ctx.resolve_path(file, loc);
   int64_t index = node.get_int("shape_index", 0);
   if (index < 0 || index > 0x7FFFFFFF)
-    throw SceneError(prop_loc(node, "shape_index"),
+    throw SceneError(node.loc_of("shape_index"),
                      "shape_index must be non-negative, got " + std::to_string(index));
   bool fn = node.get_bool("face_normals", false);
   bool flip = node.get_bool("flip_normals", false);
@@ -117,9 +112,9 @@ ShapeGeometry make_sphere(const SceneNode& node, LoadContext& ctx) {
   g.radius = node.get_float("radius", 1.f);
   g.flip_normals = node.get_bool("flip_normals", false);
   if (!(g.radius > 0.f) || !std::isfinite(g.radius))
-    throw SceneError(prop_loc(node, "radius"),
+    throw SceneError(node.loc_of("radius"),
                      "sphere radius must be positive and finite, got " + std::to_string(g.radius));
-  if (!is_finite(g.center)) throw SceneError(prop_loc(node, "center"), "sphere center is not finite");
+  if (!is_finite(g.center)) throw SceneError(node.loc_of("center"), "sphere center is not finite");
   return g;
 }
 

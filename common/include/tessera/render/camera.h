@@ -6,6 +6,7 @@
 // from the filter around the pixel centre), so each pixel's value depends on its own samples only.
 #pragma once
 
+#include "tessera/core/animated_transform.h"
 #include "tessera/core/ray.h"
 #include "tessera/core/transform.h"
 #include "tessera/core/vec.h"
@@ -73,5 +74,11 @@ std::unique_ptr<Camera> make_thinlens_camera(const Transform& world_from_camera,
 /// `world_from_camera`; the clip distances are along the (unit) world direction.
 std::unique_ptr<Camera> make_orthographic_camera(const Transform& world_from_camera, int film_width,
                                                  int film_height, float near_clip, float far_clip);
+
+/// A camera moving with `world_from_camera` (its to_world animation): `inner` was built with the
+/// transform at shutter open, `world_from_camera_open`; rays at time t are moved by
+/// world_from_camera(t) * inverse(world_from_camera_open).
+std::unique_ptr<Camera> make_animated_camera(std::unique_ptr<Camera> inner, const Transform& world_from_camera_open,
+                                             AnimatedTransform world_from_camera);
 
 }  // namespace tessera
