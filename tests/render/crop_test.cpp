@@ -21,11 +21,7 @@ TEST(Crop, CroppedRenderEqualsFullRenderPixels) {
   scene.film.height = 30;
   scene.film.filter = make_gaussian_filter(0.5f, 2.f);
   scene.finalize();
-  RenderSettings rs;
-  rs.spp = 8;
-  rs.seed = 9;
-  rs.threads = 2;
-  rs.tile_size = 8;
+  RenderSettings rs = test::render_settings(8, 9, 8);
   Film full = render(scene, rs);
 
   scene.film.crop_x = 7;

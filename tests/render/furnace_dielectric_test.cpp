@@ -38,12 +38,7 @@ Film render_furnace(Scene& scene, int rr_depth = 5) {
   scene.integrator.max_depth = 64;  // the chance that a path is still inside after 64 bounces is negligible
   scene.integrator.rr_depth = rr_depth;
   scene.finalize();
-  RenderSettings rs;
-  rs.spp = 32;
-  rs.seed = 5;
-  rs.threads = 2;
-  rs.tile_size = 16;
-  return render(scene, rs);
+  return render(scene, render_settings(32, 5));
 }
 
 // The shape that covers pixel (x, y) entirely (its centre and four corners see it first), null

@@ -6,6 +6,8 @@
 // the half of its samples that fall on the hidden side, and the density is smooth.
 #include "tessera/light/area.h"
 
+#include "light/emitter_sample.h"
+
 #include "tessera/core/frame.h"
 #include "tessera/core/sampling.h"
 #include "tessera/light/light_bounds.h"
@@ -60,23 +62,7 @@ class AreaLight final : public Light {
       if (!(pdf_area > 0.f)) return false;
       pdf = pdf_area;  // converted below, once the distance is known
     }
-    Vec3 d = p - ref_p;
-    float dist2 = length_squared(d);
-    if (!(dist2 > 0.f)) return false;
-    float dist = std::sqrt(dist2);
-    Vec3 wi = d / dist;
-    // Emission is one-sided: a point seen from behind contributes nothing.
-    float cos_light = -dot(n, wi);
-    if (!(cos_light > 0.f)) return false;
-    if (!cone) pdf *= dist2 / cos_light;
-    out.wi = wi;
-    out.li = radiance_;
-    out.p_light = p;
-    out.n_light = n;
-    out.dist = dist;
-    out.pdf = pdf;
-    out.delta = false;
-    return std::isfinite(pdf) && pdf > 0.f;
+    return detail::emission_sample(ref_p, p, n, pdf, /*pdf_is_area=*/!cone, radiance_, out);
   }
 
   Rgb le(const SurfaceInteraction& si, Vec3 w) const override {
@@ -88,14 +74,8 @@ class AreaLight final : public Light {
       Cone c = sphere_cone(length_squared(sphere_->center() - ref_p), sphere_->radius());
       return 1.f / (2.f * kPi * c.one_minus_cos_max);
     }
-    Vec3 d = si.p - ref_p;
-    float dist2 = length_squared(d);
-    if (!(dist2 > 0.f)) return 0.f;
-    float cos_light = std::abs(dot(si.ng, d)) / std::sqrt(dist2);
-    if (!(cos_light > 0.f)) return 0.f;
     // Shapes sample uniformly by area (see Shape::sample_area).
-    float pdf = dist2 / (cos_light * shape_.area());
-    return std::isfinite(pdf) ? pdf : 0.f;
+    return detail::area_pdf_to_solid_angle(ref_p, si, 1.f / shape_.area());
   }
 
   float power() const override { return kPi * shape_.area() * radiance_.luminance(); }

@@ -1,5 +1,7 @@
 #include "tessera/light/point.h"
 
+#include "light/emitter_sample.h"
+
 #include "tessera/light/light_bounds.h"
 #include "tessera/scene/load_context.h"
 
@@ -11,17 +13,8 @@ class PointLight final : public Light {
   PointLight(Vec3 position, Rgb intensity) : position_(position), intensity_(intensity) {}
 
   bool sample_li(Vec3 ref_p, Vec2, LightSample& out) const override {
-    Vec3 d = position_ - ref_p;
-    float dist2 = length_squared(d);
-    if (!(dist2 > 0.f)) return false;
-    float dist = std::sqrt(dist2);
-    out.wi = d / dist;
-    out.li = intensity_ / dist2;
-    out.p_light = position_;
-    out.n_light = Vec3(0.f);
-    out.dist = dist;
-    out.pdf = 1.f;
-    out.delta = true;
+    if (!detail::point_emitter_sample(position_, ref_p, out)) return false;
+    out.li *= intensity_;
     return true;
   }
 

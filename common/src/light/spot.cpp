@@ -8,6 +8,8 @@
 // Mitsuba 3 rejects one; Tessera ignores it with a note.
 #include "tessera/light/spot.h"
 
+#include "light/emitter_sample.h"
+
 #include "tessera/core/check.h"
 #include "tessera/light/light_bounds.h"
 #include "tessera/scene/load_context.h"
@@ -43,23 +45,13 @@ class SpotLight final : public Light {
   }
 
   bool sample_li(Vec3 ref_p, Vec2, LightSample& out) const override {
-    Vec3 d = position_ - ref_p;
-    float dist2 = length_squared(d);
-    if (!(dist2 > 0.f)) return false;
-    float dist = std::sqrt(dist2);
-    Vec3 wi = d / dist;
+    if (!detail::point_emitter_sample(position_, ref_p, out)) return false;
     // Emission direction (light -> reference point) in light space; normalised so that a scale in
     // to_world does not distort the profile.
-    Vec3 local = normalize(light_from_world_.apply_vector(-wi));
+    Vec3 local = normalize(light_from_world_.apply_vector(-out.wi));
     Rgb profile = eval_profile(local);
     if (profile.is_black()) return false;
-    out.wi = wi;
-    out.li = profile / dist2;
-    out.p_light = position_;
-    out.n_light = Vec3(0.f);
-    out.dist = dist;
-    out.pdf = 1.f;
-    out.delta = true;
+    out.li *= profile;
     return true;
   }
 

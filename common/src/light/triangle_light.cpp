@@ -4,6 +4,8 @@
 // exactly, so splitting changes no expected value.
 #include "tessera/light/triangle_light.h"
 
+#include "light/emitter_sample.h"
+
 #include "tessera/core/sampling.h"
 #include "tessera/light/light_bounds.h"
 
@@ -36,22 +38,7 @@ class TriangleLight final : public Light {
     if (!(area_ > 0.f)) return false;
     const Vec2 b = square_to_uniform_triangle(u);
     const Vec3 p = p0_ * (1.f - b.x - b.y) + p1_ * b.x + p2_ * b.y;
-    const Vec3 d = p - ref_p;
-    const float dist2 = length_squared(d);
-    if (!(dist2 > 0.f)) return false;
-    const float dist = std::sqrt(dist2);
-    const Vec3 wi = d / dist;
-    const float cos_light = -dot(n_, wi);
-    if (!(cos_light > 0.f)) return false;  // one-sided emission
-    const float pdf = dist2 / (cos_light * area_);
-    out.wi = wi;
-    out.li = radiance_;
-    out.p_light = p;
-    out.n_light = n_;
-    out.dist = dist;
-    out.pdf = pdf;
-    out.delta = false;
-    return std::isfinite(pdf) && pdf > 0.f;
+    return detail::emission_sample(ref_p, p, n_, 1.f / area_, /*pdf_is_area=*/true, radiance_, out);
   }
 
   Rgb le(const SurfaceInteraction& si, Vec3 w) const override {
@@ -60,13 +47,7 @@ class TriangleLight final : public Light {
 
   float pdf_li(Vec3 ref_p, const SurfaceInteraction& si) const override {
     if (!(area_ > 0.f)) return 0.f;
-    const Vec3 d = si.p - ref_p;
-    const float dist2 = length_squared(d);
-    if (!(dist2 > 0.f)) return 0.f;
-    const float cos_light = std::abs(dot(si.ng, d)) / std::sqrt(dist2);
-    if (!(cos_light > 0.f)) return 0.f;
-    const float pdf = dist2 / (cos_light * area_);
-    return std::isfinite(pdf) ? pdf : 0.f;
+    return detail::area_pdf_to_solid_angle(ref_p, si, 1.f / area_);
   }
 
   float power() const override { return kPi * area_ * radiance_.luminance(); }
