@@ -39,7 +39,7 @@ int main_entry(int argc, char** argv) {
   r->add_option("--seed", render.seed, "Sampling seed");
   r->add_option("-D", defines, "Override a scene <default>: -D name=value");
   r->add_option("--integrator", render.integrator, "Override the integrator")
-      ->check(CLI::IsMember({"path", "direct"}));
+      ->check(CLI::IsMember({"path", "volpath", "direct"}));
   r->add_option("--light-selection", render.light_selection,
                 "How next-event estimation picks a light: power (alias table) or bvh (light hierarchy; "
                 "default)")

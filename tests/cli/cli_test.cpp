@@ -92,6 +92,15 @@ TEST_F(CliTest, BadInputGivesAnErrorExitCode) {
   EXPECT_FALSE(fs::exists(path("x.exr")));
 }
 
+TEST_F(CliTest, EveryIntegratorTheLoaderKnowsIsAccepted) {
+  std::string scene = write_scene();
+  for (const char* integrator : {"path", "volpath", "direct"}) {
+    const std::string out = path(std::string(integrator) + ".exr");
+    EXPECT_EQ(run({"render", scene, "-o", out, "--integrator", integrator, "-q"}), 0) << integrator;
+    EXPECT_TRUE(fs::exists(out)) << integrator;
+  }
+}
+
 TEST_F(CliTest, CompareReportsAgainstAReference) {
   std::string scene = write_scene();
   ASSERT_EQ(run({"render", scene, "-o", path("c.exr"), "-q"}), 0);
