@@ -67,7 +67,47 @@ int main_entry(int argc, char** argv) {
   cmp->add_option("reference", compare.reference, "Reference image")->required()->check(CLI::ExistingFile);
   cmp->add_option("--variance", compare.variance, "Per-pixel variance of the reference")->check(CLI::ExistingFile);
 
+  SubmitOptions submit;
+  std::vector<std::string> submit_defines;
+  auto* sub = app.add_subcommand("submit", "Send a scene to a render farm coordinator (docs/api.md)");
+  sub->add_option("scene", submit.scene, "Scene file; only the files it references are uploaded")->required()
+      ->check(CLI::ExistingFile);
+  sub->add_option("--server", submit.server, "Coordinator URL (default: $TESSERA_SERVER or http://127.0.0.1:8420)");
+  sub->add_option("-o,--output", submit.outputs, "Wait, then download the image(s): .exr, .pfm or .png");
+  sub->add_flag("--wait", submit.wait, "Wait for the job to finish, with a progress bar");
+  sub->add_option("--spp", submit.spp, "Samples per pixel (default: the scene's)")->check(CLI::PositiveNumber);
+  sub->add_option("--width", submit.width, "Film width (default: the scene's)")->check(CLI::PositiveNumber);
+  sub->add_option("--height", submit.height, "Film height (default: the scene's)")->check(CLI::PositiveNumber);
+  sub->add_option("--seed", submit.seed, "Sampling seed");
+  sub->add_option("--tile-size", submit.tile_size, "Tile edge in pixels (does not change the image)")
+      ->check(CLI::Range(4, 1024));
+  sub->add_option("--priority", submit.priority, "Higher runs first");
+  sub->add_option("--name", submit.name, "Job name (default: the scene's file name)");
+  sub->add_option("-D", submit_defines, "Override a scene <default>: -D name=value");
+  sub->add_option("--integrator", submit.integrator, "Override the integrator")
+      ->check(CLI::IsMember({"path", "volpath", "direct"}));
+  sub->add_option("--light-selection", submit.light_selection, "power or bvh")->check(CLI::IsMember({"power", "bvh"}));
+  sub->add_flag("-q,--quiet", submit.quiet, "No progress output");
+
+  JobsOptions jobs;
+  auto* jl = app.add_subcommand("jobs", "List a coordinator's jobs");
+  jl->add_option("--server", jobs.server, "Coordinator URL (default: $TESSERA_SERVER or http://127.0.0.1:8420)");
+  auto* cancel = app.add_subcommand("cancel", "Cancel a job");
+  cancel->add_option("id", jobs.cancel_id, "Job id")->required();
+  cancel->add_option("--server", jobs.server, "Coordinator URL (default: $TESSERA_SERVER or http://127.0.0.1:8420)");
+
   CLI11_PARSE(app, argc, argv);
+
+  if (sub->parsed()) {
+    for (const auto& d : submit_defines)
+      if (!parse_define(d, submit.defines)) {
+        std::cerr << "tessera submit: -D expects name=value, got '" << d << "'\n";
+        return 2;
+      }
+    return run_submit(submit);
+  }
+  if (jl->parsed()) return run_jobs(jobs);
+  if (cancel->parsed()) return run_cancel(jobs);
 
   if (r->parsed()) {
     for (const auto& d : defines)

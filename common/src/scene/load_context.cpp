@@ -39,6 +39,7 @@ std::string LoadContext::resolve_path(const std::string& name, const FileLoc& lo
   for (const fs::path& c : candidates) {
     if (!fs::is_regular_file(c, ec)) continue;
     if (!std::ifstream(c, std::ios::binary)) throw SceneError(loc, "cannot read '" + c.string() + "'");
+    if (resolved_set_.insert(c.string()).second) resolved_files_.push_back(c.string());
     return c.string();
   }
   throw SceneError(loc, "file not found: '" + name + "' (looked in '" +

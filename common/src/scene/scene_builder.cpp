@@ -294,6 +294,7 @@ LoadResult load_scene(const SceneDesc& desc, const LoadOptions& options) {
   LoadResult result;
   result.scene = std::move(scene);
   result.messages = ctx.messages();
+  result.files = ctx.resolved_files();
   if (options.allow_unsupported) result.unsupported = ctx.unsupported_items();
   return result;
 }

@@ -100,6 +100,8 @@ class Parser {
     desc.root->tag = "scene";
     desc.root->loc = src.loc(root);
     parse_children(src, root, *desc.root, 1);
+    desc.included_files = std::move(included_files_);
+    desc.spectrum_files = std::move(spectrum_files_);
     return desc;
   }
 
@@ -108,6 +110,8 @@ class Parser {
   std::map<std::string, std::shared_ptr<SceneNode>> ids_;
   std::vector<std::string> include_stack_;     // canonical paths, for cycle detection
   std::string base_dir_;
+  std::vector<std::string> included_files_;    // as opened, for SceneDesc
+  std::vector<std::string> spectrum_files_;
 
   /// Parses `src.text`, checks the <scene> root and its version; returns the root element.
   pugi::xml_node load_document(Source& src, std::optional<int> inherited_version) {
@@ -281,6 +285,11 @@ class Parser {
       parse_animation(src, el, prop);
     } else if (!xml::parse_value_property(tag, attrs, loc, base_dir_, prop)) {
       throw SceneError(loc, "unknown element <" + tag + ">");
+    } else if (const std::string* file = attrs.get("filename"); file && tag == "spectrum") {
+      // Resolved as xml::read_spectrum_file just did: against the scene's directory.
+      fs::path p(*file);
+      if (p.is_relative() && !base_dir_.empty()) p = fs::path(base_dir_) / p;
+      spectrum_files_.push_back(p.string());
     }
     parent.props.push_back(std::move(prop));
   }
@@ -420,6 +429,7 @@ class Parser {
     ss << in.rdbuf();
     if (!in && !in.eof()) throw SceneError(loc, "cannot read included file " + squote(filename));
     inc.text = ss.str();
+    included_files_.push_back(found->first.string());
     pugi::xml_node root = load_document(inc, src.version_major);
     include_stack_.push_back(canonical);
     parse_children(inc, root, parent, depth + 1);

@@ -29,11 +29,32 @@ struct CompareOptions {
   std::string image, reference, variance;  // variance: the reference's per-pixel variance (optional)
 };
 
+/// `tessera submit`: the same rendering flags as render, sent to a coordinator.
+struct SubmitOptions {
+  std::string scene, server;
+  std::vector<std::string> outputs;  // implies wait
+  int spp = 0, width = 0, height = 0, tile_size = 32, priority = 0;
+  uint32_t seed = 0;
+  std::map<std::string, std::string> defines;
+  std::string integrator, light_selection, name;
+  bool wait = false, quiet = false;
+};
+
+struct JobsOptions {
+  std::string server;
+  uint64_t cancel_id = 0;  // run_cancel
+};
+
 /// Each returns the process exit code and prints its own messages.
 int run_render(const RenderOptions& options);
 /// `geometry` may also be a single scene .xml: its accelerator is used.
 int run_bench_rays(const BenchRaysOptions& options);
 int run_compare(const CompareOptions& options);
+int run_submit(const SubmitOptions& options);
+int run_jobs(const JobsOptions& options);
+int run_cancel(const JobsOptions& options);
+/// $TESSERA_SERVER, else http://127.0.0.1:8420.
+std::string default_server_url();
 
 /// Parses argv and runs the chosen subcommand.
 int main_entry(int argc, char** argv);

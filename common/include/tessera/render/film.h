@@ -78,6 +78,8 @@ class FilmTile {
   }
   const PixelSums& pixel(Vec2i p) const { return pixels_[index(p)]; }
   const std::vector<PixelSums>& pixels() const { return pixels_; }
+  /// For decoders of remote tile results (farm/tile_result.h); size stays rect().area().
+  std::vector<PixelSums>& mutable_pixels() { return pixels_; }
 
   RenderCounters counters;
 

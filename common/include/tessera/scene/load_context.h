@@ -18,6 +18,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -84,6 +85,9 @@ class LoadContext {
 
   const std::vector<LoadMessage>& messages() const { return messages_; }
   const std::vector<UnsupportedItem>& unsupported_items() const { return unsupported_; }
+  /// Every path resolve_path returned, without repeats, in first-use order: the files the loaded
+  /// plugins read (what a scene bundle must carry).
+  const std::vector<std::string>& resolved_files() const { return resolved_files_; }
 
  private:
   const SceneDesc& desc_;
@@ -97,6 +101,9 @@ class LoadContext {
   const Bsdf* null_bsdf_ = nullptr;
   std::map<std::string, std::shared_ptr<const MeshData>> meshes_;
   std::map<std::string, std::shared_ptr<const Image>> images_;
+  // resolve_path is const (a look-up) yet records what it found.
+  mutable std::vector<std::string> resolved_files_;
+  mutable std::set<std::string> resolved_set_;
 };
 
 using BsdfFactory = std::shared_ptr<Bsdf> (*)(const SceneNode&, LoadContext&);
@@ -139,6 +146,9 @@ struct LoadResult {
   std::unique_ptr<Scene> scene;
   std::vector<LoadMessage> messages;
   std::vector<UnsupportedItem> unsupported;  // non-empty only with allow_unsupported
+  /// Every file the loader opened (LoadContext::resolved_files): with SceneDesc's file,
+  /// included_files and spectrum_files, what the scene needs (farm/bundle.h scene_files()).
+  std::vector<std::string> files;
 };
 
 /// Parsed description -> renderable scene (meshes and images loaded, BVH built). Throws SceneError,

@@ -92,6 +92,10 @@ struct SceneDesc {
   std::string version;              // as written
   std::string file;                 // path of the top-level XML
   std::string base_dir;             // directory relative file names resolve against
+  /// Files the parser read besides `file` (for bundling a scene), as opened, in reading order:
+  /// each <include>d XML, and each <spectrum filename=..> data file.
+  std::vector<std::string> included_files;
+  std::vector<std::string> spectrum_files;
 };
 
 struct ParseOptions {

@@ -1,0 +1,167 @@
+// `tessera submit`, `tessera jobs`, `tessera cancel`: the farm's client side. submit loads the
+// scene locally first, so only the files it references are bundled and a broken scene fails here.
+#include "tessera/cli/commands.h"
+#include "tessera/cli/progress.h"
+#include "tessera/farm/bundle.h"
+#include "tessera/farm/job_scene.h"
+#include "tessera/scene/error.h"
+#include "tessera/worker/farm_client.h"
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <thread>
+
+namespace tessera::cli {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+std::string default_server_url() {
+  const char* env = std::getenv("TESSERA_SERVER");
+  return env && *env ? env : "http://127.0.0.1:8420";
+}
+
+namespace {
+
+std::string extension_of(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  for (auto& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+  return ext.empty() ? ext : ext.substr(1);
+}
+
+bool download_outputs(const farm::FarmClient& client, uint64_t id, const std::vector<std::string>& outputs) {
+  for (const std::string& out : outputs) {
+    farm::HttpReply r = client.get("/api/v1/jobs/" + std::to_string(id) + "/image?format=" + extension_of(out), 300);
+    if (!r.ok()) {
+      std::cerr << "tessera submit: cannot download the image: " << r.describe() << "\n";
+      return false;
+    }
+    if (fs::path(out).has_parent_path()) fs::create_directories(fs::path(out).parent_path());
+    std::ofstream(out, std::ios::binary).write(r.body.data(), std::streamsize(r.body.size()));
+    std::cerr << "wrote " << out << "\n";
+  }
+  return true;
+}
+
+// Polls until the job ends; returns its final status (null when the server stays unreachable).
+json wait_for(const farm::FarmClient& client, uint64_t id, bool quiet) {
+  Progress progress("job " + std::to_string(id), !quiet);
+  int failures = 0;
+  for (;;) {
+    farm::HttpReply r = client.get("/api/v1/jobs/" + std::to_string(id), 30);
+    json j = r.json();
+    if (r.ok() && j.is_object()) {
+      failures = 0;
+      progress.update(j.value("progress", 0.0), 1.0);
+      std::string state = j.value("state", "");
+      if (state == "done" || state == "failed" || state == "cancelled") {
+        progress.finish();
+        return j;
+      }
+    } else if (++failures > 300) {  // about ten minutes without an answer: the coordinator is gone
+      progress.finish();
+      std::cerr << "tessera submit: lost the coordinator: " << r.describe() << "\n";
+      return nullptr;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(r.ok() ? 250 : 2000));
+  }
+}
+
+}  // namespace
+
+int run_submit(const SubmitOptions& o) {
+  for (const auto& out : o.outputs) {
+    std::string ext = extension_of(out);
+    if (ext != "exr" && ext != "png" && ext != "pfm") {
+      std::cerr << "tessera submit: output '" << out << "': unknown format (use .exr, .pfm or .png)\n";
+      return 2;
+    }
+  }
+  farm::FarmClient client(o.server.empty() ? default_server_url() : o.server);
+  std::string why;
+  if (!client.valid(&why)) {
+    std::cerr << "tessera submit: " << why << "\n";
+    return 2;
+  }
+  JobSettings settings;
+  settings.name = o.name.empty() ? fs::path(o.scene).stem().string() : o.name;
+  settings.spp = o.spp;
+  settings.width = o.width;
+  settings.height = o.height;
+  settings.seed = o.seed;
+  settings.tile_size = o.tile_size;
+  settings.priority = o.priority;
+  settings.defines = o.defines;
+  settings.integrator = o.integrator;
+  settings.light_selection = o.light_selection;
+
+  std::string bundle;
+  try {
+    const fs::path scene = fs::absolute(o.scene);
+    LoadedJobScene loaded = load_job_scene(scene.parent_path().string(), scene.filename().string(), settings);
+    BundlePlan plan = plan_bundle(scene.string(), scene_files(loaded.desc, loaded.loaded));
+    settings.scene_file = plan.files.front();
+    bundle = pack_bundle(plan.root_dir, plan.files);
+    std::cerr << "bundled " << plan.files.size() << " files (" << bundle.size() / 1024 << " KiB) from " << plan.root_dir
+              << "\n";
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 1;
+  }
+  json body = to_json(settings);
+  body.erase("scene");
+  farm::HttpReply r = client.post_job_with_bundle(body, bundle);
+  json j = r.json();
+  if (!r.ok() || !j.is_object()) {
+    std::cerr << "tessera submit: the coordinator refused the job: " << r.describe() << "\n";
+    return 1;
+  }
+  const uint64_t id = j.value("id", uint64_t(0));
+  std::cout << id << "\n";
+  std::cerr << "job " << id << " submitted to " << client.url() << ": " << j.value("width", 0) << "x"
+            << j.value("height", 0) << ", " << j.value("spp", 0) << " spp, " << j.value("tiles", 0) << " tiles x "
+            << j.value("passes", 0) << " passes\n";
+  if (!o.wait && o.outputs.empty()) return 0;
+  json final_status = wait_for(client, id, o.quiet);
+  if (final_status.is_null()) return 1;
+  if (final_status.value("state", "") != "done") {
+    std::cerr << "job " << id << " " << final_status.value("state", "") << ": " << final_status.value("error", "")
+              << "\n";
+    return 1;
+  }
+  std::cerr << "job " << id << " done in " << final_status.value("elapsed_seconds", 0.0) << " s\n";
+  return download_outputs(client, id, o.outputs) ? 0 : 1;
+}
+
+int run_jobs(const JobsOptions& o) {
+  farm::FarmClient client(o.server.empty() ? default_server_url() : o.server);
+  farm::HttpReply r = client.get("/api/v1/jobs");
+  json j = r.json();
+  if (!r.ok() || !j.is_object()) {
+    std::cerr << "tessera jobs: " << r.describe() << "\n";
+    return 1;
+  }
+  std::printf("%6s  %-10s %6s %9s %11s %6s  %s\n", "ID", "STATE", "PRIO", "PROGRESS", "SIZE", "SPP", "NAME");
+  for (const json& job : j["jobs"])
+    std::printf("%6llu  %-10s %6d %8.1f%% %5dx%-5d %6d  %s\n", (unsigned long long)job.value("id", uint64_t(0)),
+                job.value("state", "").c_str(), job.value("priority", 0), 100.0 * job.value("progress", 0.0),
+                job.value("width", 0), job.value("height", 0), job.value("spp", 0), job.value("name", "").c_str());
+  return 0;
+}
+
+int run_cancel(const JobsOptions& o) {
+  farm::FarmClient client(o.server.empty() ? default_server_url() : o.server);
+  farm::HttpReply r = client.del("/api/v1/jobs/" + std::to_string(o.cancel_id));
+  if (!r.ok()) {
+    std::cerr << "tessera cancel: " << r.describe() << "\n";
+    return 1;
+  }
+  std::cerr << "job " << o.cancel_id << " cancelled\n";
+  return 0;
+}
+
+}  // namespace tessera::cli

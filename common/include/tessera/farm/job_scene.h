@@ -1,0 +1,43 @@
+// Loading a job's scene the same way everywhere: the coordinator at submission (to fail fast and
+// learn the film), each worker before rendering, and `tessera render` for the same settings. One
+// function so that the three can never disagree about what the settings mean.
+#pragma once
+
+#include "tessera/farm/protocol.h"
+#include "tessera/scene/load_context.h"
+
+#include <string>
+#include <vector>
+
+namespace tessera {
+
+/// What the coordinator needs to know about a job's scene to cut it into work.
+struct JobPlan {
+  JobSettings settings;          // spp, width, height resolved from the scene where they were 0
+  std::string scene_file;        // XML path inside the bundle
+  std::vector<std::string> files;  // bundle-relative files the scene references, XML first
+  TileRect window;               // the film's crop window
+  int full_width = 0, full_height = 0;
+  bool ldr = false;              // ldrfilm: PNG output uses gamma/exposure below
+  float gamma = -1.f, exposure = 0.f;
+};
+
+struct LoadedJobScene {
+  SceneDesc desc;
+  LoadResult loaded;
+};
+
+/// Parses and loads `bundle_dir/scene_file` with the job's defines, size, spp, integrator and light
+/// selection. Throws SceneError / UnsupportedError as load_scene does (messages name the file and
+/// line inside the bundle).
+LoadedJobScene load_job_scene(const std::string& bundle_dir, const std::string& scene_file,
+                              const JobSettings& settings);
+
+/// The plan for a loaded scene (`files` made relative to bundle_dir).
+JobPlan make_job_plan(const std::string& bundle_dir, const std::string& scene_file, const JobSettings& settings,
+                      const LoadedJobScene& scene);
+
+nlohmann::json to_json(const JobPlan& p);
+[[nodiscard]] bool job_plan_from_json(const nlohmann::json& j, JobPlan& out, std::string& error);
+
+}  // namespace tessera

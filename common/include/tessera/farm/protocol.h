@@ -1,0 +1,76 @@
+// The farm's JSON messages (docs/api.md): job settings as submitted, a lease as handed to a
+// worker, a worker's registration. Parsing is strict: unknown fields, wrong types and absurd values
+// are errors naming the field, because a typo in a job must not silently render something else.
+#pragma once
+
+#include "tessera/render/film.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace tessera {
+
+/// What a client asks for. Zero sizes/spp mean "as the scene says".
+struct JobSettings {
+  std::string name;
+  std::string scene;        // bundle hash (SHA-256 hex)
+  std::string scene_file;   // the XML inside the bundle; empty: the single *.xml at its root
+  int spp = 0, width = 0, height = 0;
+  uint32_t seed = 0;
+  int tile_size = 32;
+  int priority = 0;         // higher first
+  std::map<std::string, std::string> defines;
+  std::string integrator;       // empty: the scene's
+  std::string light_selection;  // empty: the default
+};
+
+/// Limits a job must respect (the coordinator's flags).
+struct JobLimits {
+  int max_spp = 1 << 20;
+  int max_resolution = 32768;  // per side
+  int64_t max_pixels = int64_t(1) << 28;
+  int max_tile_size = 1024, min_tile_size = 4;
+};
+
+nlohmann::json to_json(const JobSettings& s);
+/// `j` must be an object; `require_scene` demands the `scene` field (not for multipart uploads).
+[[nodiscard]] bool job_settings_from_json(const nlohmann::json& j, JobSettings& out, std::string& error,
+                                          bool require_scene = true);
+/// Range checks after the scene's defaults are known.
+[[nodiscard]] bool check_job_limits(const JobSettings& s, const JobLimits& limits, std::string& error);
+
+/// One unit of work: samples [sample_begin, sample_end) of every pixel of `rect`.
+struct Lease {
+  uint64_t id = 0;
+  uint64_t job_id = 0;
+  uint32_t tile = 0, pass = 0;
+  TileRect rect;
+  uint32_t sample_begin = 0, sample_end = 0;
+  double seconds_to_expiry = 0;  // heartbeat before this
+  JobSettings settings;          // the job's, with spp/width/height resolved
+  std::string scene_file;        // resolved XML path inside the bundle
+  std::vector<std::string> files;  // bundle files the scene references (the worker unpacks only these)
+};
+
+nlohmann::json to_json(const Lease& l);
+[[nodiscard]] bool lease_from_json(const nlohmann::json& j, Lease& out, std::string& error);
+
+struct WorkerHello {
+  std::string name;
+  int threads = 1;
+  uint64_t memory_bytes = 0;
+  std::string version, isa, probe;  // build_fingerprint.h
+};
+
+nlohmann::json to_json(const WorkerHello& h);
+[[nodiscard]] bool worker_hello_from_json(const nlohmann::json& j, WorkerHello& out, std::string& error);
+
+/// The key under which a worker caches a loaded scene: everything that changes what load_scene
+/// builds (bundle, XML, defines, size, spp, integrator, light selection).
+std::string scene_cache_key(const JobSettings& resolved, const std::string& scene_file);
+
+}  // namespace tessera

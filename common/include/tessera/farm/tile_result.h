@@ -1,0 +1,38 @@
+// The farm's work result on the wire: the pixel sums of one tile x sample pass.
+//
+// Layout (little-endian, the whole of it zstd-compressed):
+//   "TSTR" magic, u32 format version,
+//   u64 job id, u32 tile index, u32 pass index, i32 x0 y0 x1 y1, u32 sample_begin, sample_end,
+//   u64 samples, camera_rays, bounce_rays, shadow_rays, nonfinite, f64 render seconds,
+//   per pixel (row-major over the rect): f64 sum[3], f64 sum_sq[3], u64 count,
+//   32-byte SHA-256 of everything above.
+// The coordinator adds decoded tiles to its Film exactly as render() does, so the stitched image is
+// bit-identical to a local render (render/renderer.h).
+#pragma once
+
+#include "tessera/render/film.h"
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+namespace tessera {
+
+struct TileResult {
+  uint64_t job_id = 0;
+  uint32_t tile = 0, pass = 0;
+  uint32_t sample_begin = 0, sample_end = 0;
+  double seconds = 0;  // time the worker spent rendering it
+  FilmTile film;       // rect, sums and counters
+};
+
+/// Encodes (and compresses) a result; `level` is zstd's compression level.
+std::string encode_tile_result(const TileResult& result, int level = 3);
+
+/// Decodes and verifies bytes from the network. False with `error` set on anything malformed:
+/// bad compression, wrong magic or version, a size that does not match the rect, a checksum
+/// mismatch, a rect larger than `max_pixels`.
+[[nodiscard]] bool decode_tile_result(std::string_view bytes, TileResult& out, std::string& error,
+                                      int64_t max_pixels = int64_t(1) << 24);
+
+}  // namespace tessera

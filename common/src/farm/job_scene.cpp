@@ -1,0 +1,92 @@
+#include "tessera/farm/job_scene.h"
+
+#include "tessera/farm/bundle.h"
+#include "tessera/light/light_sampler.h"
+#include "tessera/scene/error.h"
+
+#include <algorithm>
+#include <filesystem>
+
+namespace tessera {
+
+namespace fs = std::filesystem;
+
+LoadedJobScene load_job_scene(const std::string& bundle_dir, const std::string& scene_file,
+                              const JobSettings& settings) {
+  ParseOptions parse_options;
+  parse_options.defines = settings.defines;
+  LoadedJobScene out;
+  out.desc = parse_scene_file((fs::path(bundle_dir) / scene_file).string(), parse_options);
+  LoadOptions load_options;
+  load_options.width = settings.width;
+  load_options.height = settings.height;
+  load_options.spp = settings.spp;
+  load_options.integrator = settings.integrator;
+  out.loaded = load_scene(out.desc, load_options);
+  if (!settings.light_selection.empty()) {
+    LightSelection selection;
+    if (!parse_light_selection(settings.light_selection, selection))
+      throw SceneError(FileLoc{scene_file, 0}, "unknown light selection '" + settings.light_selection + "'");
+    out.loaded.scene->set_light_selection(selection);
+  }
+  return out;
+}
+
+JobPlan make_job_plan(const std::string& bundle_dir, const std::string& scene_file, const JobSettings& settings,
+                      const LoadedJobScene& scene) {
+  const Scene& s = *scene.loaded.scene;
+  JobPlan plan;
+  plan.settings = settings;
+  plan.settings.spp = s.sampler.sample_count;
+  plan.settings.width = s.film.width;
+  plan.settings.height = s.film.height;
+  plan.scene_file = scene_file;
+  plan.window = film_window(s.film);
+  plan.full_width = s.film.width;
+  plan.full_height = s.film.height;
+  plan.ldr = s.film.ldr;
+  plan.gamma = s.film.gamma;
+  plan.exposure = s.film.exposure;
+  const fs::path root = fs::weakly_canonical(bundle_dir);
+  for (const std::string& f : scene_files(scene.desc, scene.loaded)) {
+    std::string rel = fs::weakly_canonical(f).lexically_relative(root).generic_string();
+    if (rel.empty() || rel.rfind("..", 0) == 0)
+      throw SceneError(FileLoc{scene_file, 0}, "the scene references '" + f + "', which is outside its bundle");
+    if (std::find(plan.files.begin(), plan.files.end(), rel) == plan.files.end()) plan.files.push_back(rel);
+  }
+  return plan;
+}
+
+nlohmann::json to_json(const JobPlan& p) {
+  return {{"settings", to_json(p.settings)},
+          {"scene_file", p.scene_file},
+          {"files", p.files},
+          {"window", {p.window.x0, p.window.y0, p.window.x1, p.window.y1}},
+          {"full_width", p.full_width},
+          {"full_height", p.full_height},
+          {"ldr", p.ldr},
+          {"gamma", p.gamma},
+          {"exposure", p.exposure}};
+}
+
+bool job_plan_from_json(const nlohmann::json& j, JobPlan& out, std::string& error) {
+  try {
+    if (!job_settings_from_json(j.at("settings"), out.settings, error)) return false;
+    out.scene_file = j.at("scene_file").get<std::string>();
+    out.files = j.at("files").get<std::vector<std::string>>();
+    auto w = j.at("window").get<std::vector<int>>();
+    if (w.size() != 4) throw std::invalid_argument("window");
+    out.window = {w[0], w[1], w[2], w[3]};
+    out.full_width = j.at("full_width").get<int>();
+    out.full_height = j.at("full_height").get<int>();
+    out.ldr = j.at("ldr").get<bool>();
+    out.gamma = j.at("gamma").get<float>();
+    out.exposure = j.at("exposure").get<float>();
+    return true;
+  } catch (const std::exception& e) {
+    error = std::string("job plan: ") + e.what();
+    return false;
+  }
+}
+
+}  // namespace tessera

@@ -1,0 +1,222 @@
+#include "tessera/farm/protocol.h"
+
+#include "tessera/farm/sha256.h"
+
+#include <set>
+
+namespace tessera {
+namespace {
+
+using nlohmann::json;
+
+// Strict field reader: records the first error, names the field and what it should have been.
+class Fields {
+ public:
+  Fields(const json& j, std::string& error, const char* what) : j_(j), error_(error), what_(what) {
+    if (!j.is_object()) fail(std::string(what) + ": expected a JSON object");
+  }
+  bool ok() const { return error_.empty(); }
+
+  template <class T>
+  void get(const char* name, T& out, bool required = false) {
+    seen_.insert(name);
+    if (!ok()) return;
+    auto it = j_.find(name);
+    if (it == j_.end() || it->is_null()) {
+      if (required) fail(std::string(what_) + ": missing field '" + name + "'");
+      return;
+    }
+    try {
+      if constexpr (std::is_integral_v<T>) {
+        if (!it->is_number_integer()) throw std::invalid_argument("an integer");
+        int64_t v = it->template get<int64_t>();
+        if (v < int64_t(std::numeric_limits<T>::min()) || uint64_t(v) > uint64_t(std::numeric_limits<T>::max()))
+          throw std::invalid_argument("an integer in range");
+        out = T(v);
+      } else if constexpr (std::is_floating_point_v<T>) {
+        if (!it->is_number()) throw std::invalid_argument("a number");
+        out = it->template get<T>();
+      } else if constexpr (std::is_same_v<T, std::string>) {
+        if (!it->is_string()) throw std::invalid_argument("a string");
+        out = it->template get<std::string>();
+      } else {
+        out = it->template get<T>();
+      }
+    } catch (const std::exception& e) {
+      fail(std::string(what_) + ": field '" + name + "' must be " + e.what());
+    }
+  }
+  void get_strings(const char* name, std::map<std::string, std::string>& out) {
+    seen_.insert(name);
+    if (!ok()) return;
+    auto it = j_.find(name);
+    if (it == j_.end() || it->is_null()) return;
+    if (!it->is_object()) return fail(std::string(what_) + ": field '" + name + "' must be an object of strings");
+    for (auto& [k, v] : it->items()) {
+      if (v.is_string()) out[k] = v.get<std::string>();
+      else if (v.is_number() || v.is_boolean()) out[k] = v.dump();
+      else return fail(std::string(what_) + ": field '" + name + "." + k + "' must be a string");
+    }
+  }
+  void get_list(const char* name, std::vector<std::string>& out) {
+    seen_.insert(name);
+    if (!ok()) return;
+    auto it = j_.find(name);
+    if (it == j_.end() || it->is_null()) return;
+    if (!it->is_array()) return fail(std::string(what_) + ": field '" + name + "' must be an array of strings");
+    for (auto& v : *it) {
+      if (!v.is_string()) return fail(std::string(what_) + ": field '" + name + "' must be an array of strings");
+      out.push_back(v.get<std::string>());
+    }
+  }
+  /// Unknown fields are errors: a misspelt "sp" must not render the scene's default spp.
+  void finish() {
+    if (!ok()) return;
+    for (auto& [k, v] : j_.items())
+      if (!seen_.count(k)) return fail(std::string(what_) + ": unknown field '" + k + "'");
+  }
+  void fail(const std::string& msg) {
+    if (error_.empty()) error_ = msg;
+  }
+
+ private:
+  const json& j_;
+  std::string& error_;
+  const char* what_;
+  std::set<std::string> seen_;
+};
+
+}  // namespace
+
+json to_json(const JobSettings& s) {
+  json j = {{"name", s.name},   {"scene", s.scene},         {"scene_file", s.scene_file},
+            {"spp", s.spp},     {"width", s.width},         {"height", s.height},
+            {"seed", s.seed},   {"tile_size", s.tile_size}, {"priority", s.priority},
+            {"defines", s.defines}, {"integrator", s.integrator}, {"light_selection", s.light_selection}};
+  return j;
+}
+
+bool job_settings_from_json(const json& j, JobSettings& out, std::string& error, bool require_scene) {
+  Fields f(j, error, "job settings");
+  f.get("name", out.name);
+  f.get("scene", out.scene, require_scene);
+  f.get("scene_file", out.scene_file);
+  f.get("spp", out.spp);
+  f.get("width", out.width);
+  f.get("height", out.height);
+  f.get("seed", out.seed);
+  f.get("tile_size", out.tile_size);
+  f.get("priority", out.priority);
+  f.get_strings("defines", out.defines);
+  f.get("integrator", out.integrator);
+  f.get("light_selection", out.light_selection);
+  f.finish();
+  if (!f.ok()) return false;
+  if (!out.scene.empty() && !is_sha256_hex(out.scene)) {
+    error = "job settings: field 'scene' must be a bundle hash (64 lowercase hex digits)";
+    return false;
+  }
+  if (out.name.size() > 200) {
+    error = "job settings: field 'name' is longer than 200 characters";
+    return false;
+  }
+  return true;
+}
+
+bool check_job_limits(const JobSettings& s, const JobLimits& l, std::string& error) {
+  auto fail = [&](const std::string& m) {
+    error = "job settings: " + m;
+    return false;
+  };
+  if (s.spp < 0 || s.spp > l.max_spp) return fail("spp " + std::to_string(s.spp) + " is outside 1.." + std::to_string(l.max_spp));
+  for (auto [name, v] : {std::pair{"width", s.width}, std::pair{"height", s.height}})
+    if (v < 0 || v > l.max_resolution)
+      return fail(std::string(name) + " " + std::to_string(v) + " is outside 1.." + std::to_string(l.max_resolution));
+  if (int64_t(s.width) * s.height > l.max_pixels) return fail("the image has more than " + std::to_string(l.max_pixels) + " pixels");
+  if (s.tile_size < l.min_tile_size || s.tile_size > l.max_tile_size)
+    return fail("tile_size " + std::to_string(s.tile_size) + " is outside " + std::to_string(l.min_tile_size) + ".." +
+                std::to_string(l.max_tile_size));
+  if (!s.integrator.empty() && s.integrator != "path" && s.integrator != "volpath" && s.integrator != "direct")
+    return fail("integrator '" + s.integrator + "' is not path, volpath or direct");
+  if (!s.light_selection.empty() && s.light_selection != "power" && s.light_selection != "bvh")
+    return fail("light_selection '" + s.light_selection + "' is not power or bvh");
+  return true;
+}
+
+json to_json(const Lease& l) {
+  return {{"id", l.id},
+          {"job", l.job_id},
+          {"tile", l.tile},
+          {"pass", l.pass},
+          {"rect", {l.rect.x0, l.rect.y0, l.rect.x1, l.rect.y1}},
+          {"sample_begin", l.sample_begin},
+          {"sample_end", l.sample_end},
+          {"seconds_to_expiry", l.seconds_to_expiry},
+          {"settings", to_json(l.settings)},
+          {"scene_file", l.scene_file},
+          {"files", l.files}};
+}
+
+bool lease_from_json(const json& j, Lease& out, std::string& error) {
+  Fields f(j, error, "lease");
+  std::vector<int> rect;
+  json settings;
+  f.get("id", out.id, true);
+  f.get("job", out.job_id, true);
+  f.get("tile", out.tile, true);
+  f.get("pass", out.pass, true);
+  f.get("rect", rect, true);
+  f.get("sample_begin", out.sample_begin, true);
+  f.get("sample_end", out.sample_end, true);
+  f.get("seconds_to_expiry", out.seconds_to_expiry);
+  f.get("settings", settings, true);
+  f.get("scene_file", out.scene_file, true);
+  f.get_list("files", out.files);
+  f.finish();
+  if (!f.ok()) return false;
+  if (rect.size() != 4) {
+    error = "lease: 'rect' must be [x0, y0, x1, y1]";
+    return false;
+  }
+  out.rect = {rect[0], rect[1], rect[2], rect[3]};
+  if (out.rect.empty() || out.sample_end <= out.sample_begin) {
+    error = "lease: empty rectangle or sample range";
+    return false;
+  }
+  return job_settings_from_json(settings, out.settings, error);
+}
+
+json to_json(const WorkerHello& h) {
+  return {{"name", h.name},       {"threads", h.threads}, {"memory_bytes", h.memory_bytes},
+          {"version", h.version}, {"isa", h.isa},         {"probe", h.probe}};
+}
+
+bool worker_hello_from_json(const json& j, WorkerHello& out, std::string& error) {
+  Fields f(j, error, "worker registration");
+  f.get("name", out.name);
+  f.get("threads", out.threads);
+  f.get("memory_bytes", out.memory_bytes);
+  f.get("version", out.version, true);
+  f.get("isa", out.isa, true);
+  f.get("probe", out.probe, true);
+  f.finish();
+  if (!f.ok()) return false;
+  if (out.threads < 1 || out.threads > 4096) {
+    error = "worker registration: 'threads' must be 1..4096";
+    return false;
+  }
+  if (out.name.size() > 200) {
+    error = "worker registration: 'name' is longer than 200 characters";
+    return false;
+  }
+  return true;
+}
+
+std::string scene_cache_key(const JobSettings& s, const std::string& scene_file) {
+  json j = {{"scene", s.scene}, {"file", scene_file},         {"defines", s.defines},
+            {"spp", s.spp},     {"width", s.width},           {"height", s.height},
+            {"integrator", s.integrator}, {"light_selection", s.light_selection}};
+  return sha256_hex(j.dump());
+}
+
+}  // namespace tessera

@@ -1,0 +1,126 @@
+#include "tessera/farm/tile_result.h"
+
+#include "tessera/farm/sha256.h"
+
+#include <zstd.h>
+
+#include <bit>
+#include <cstring>
+
+namespace tessera {
+namespace {
+
+static_assert(std::endian::native == std::endian::little, "the tile format is little-endian");
+constexpr char kMagic[4] = {'T', 'S', 'T', 'R'};
+constexpr uint32_t kVersion = 1;
+constexpr size_t kHeaderBytes = 4 + 4 + 8 + 4 + 4 + 16 + 8 + 5 * 8 + 8;
+constexpr size_t kPixelBytes = 7 * 8;
+
+template <class T>
+void put(std::string& out, const T& v) {
+  out.append(reinterpret_cast<const char*>(&v), sizeof(T));
+}
+
+struct Reader {
+  std::string_view in;
+  size_t pos = 0;
+  template <class T>
+  T get() {
+    T v;
+    std::memcpy(&v, in.data() + pos, sizeof(T));
+    pos += sizeof(T);
+    return v;
+  }
+};
+
+}  // namespace
+
+std::string encode_tile_result(const TileResult& r, int level) {
+  const TileRect& rect = r.film.rect();
+  const RenderCounters& c = r.film.counters;
+  std::string raw;
+  raw.reserve(kHeaderBytes + size_t(rect.area()) * kPixelBytes + 32);
+  raw.append(kMagic, 4);
+  put(raw, kVersion);
+  put(raw, r.job_id);
+  put(raw, r.tile);
+  put(raw, r.pass);
+  for (int v : {rect.x0, rect.y0, rect.x1, rect.y1}) put(raw, int32_t(v));
+  put(raw, r.sample_begin);
+  put(raw, r.sample_end);
+  for (uint64_t v : {c.samples, c.camera_rays, c.bounce_rays, c.shadow_rays, c.nonfinite}) put(raw, v);
+  put(raw, r.seconds);
+  for (const PixelSums& px : r.film.pixels()) {
+    for (double v : px.sum) put(raw, v);
+    for (double v : px.sum_sq) put(raw, v);
+    put(raw, uint64_t(px.count));
+  }
+  Sha256Digest digest = sha256(raw);
+  raw.append(reinterpret_cast<const char*>(digest.data()), digest.size());
+
+  std::string out(ZSTD_compressBound(raw.size()), '\0');
+  size_t n = ZSTD_compress(out.data(), out.size(), raw.data(), raw.size(), level);
+  out.resize(ZSTD_isError(n) ? 0 : n);  // compressBound makes an error impossible
+  return out;
+}
+
+bool decode_tile_result(std::string_view bytes, TileResult& out, std::string& error, int64_t max_pixels) {
+  unsigned long long size = ZSTD_getFrameContentSize(bytes.data(), bytes.size());
+  if (size == ZSTD_CONTENTSIZE_ERROR || size == ZSTD_CONTENTSIZE_UNKNOWN) {
+    error = "tile result: not a zstd frame with a known size";
+    return false;
+  }
+  const unsigned long long max_size = kHeaderBytes + 32 + (unsigned long long)max_pixels * kPixelBytes;
+  if (size < kHeaderBytes + 32 || size > max_size) {
+    error = "tile result: implausible size " + std::to_string(size) + " bytes";
+    return false;
+  }
+  std::string raw(size_t(size), '\0');
+  size_t n = ZSTD_decompress(raw.data(), raw.size(), bytes.data(), bytes.size());
+  if (ZSTD_isError(n) || n != raw.size()) {
+    error = std::string("tile result: corrupt or truncated: ") + (ZSTD_isError(n) ? ZSTD_getErrorName(n) : "short");
+    return false;
+  }
+  Sha256Digest digest = sha256(raw.data(), raw.size() - 32);
+  if (std::memcmp(digest.data(), raw.data() + raw.size() - 32, 32) != 0) {
+    error = "tile result: checksum mismatch";
+    return false;
+  }
+  Reader rd{raw};
+  if (std::memcmp(raw.data(), kMagic, 4) != 0) {
+    error = "tile result: bad magic";
+    return false;
+  }
+  rd.pos = 4;
+  if (uint32_t v = rd.get<uint32_t>(); v != kVersion) {
+    error = "tile result: format version " + std::to_string(v) + ", expected " + std::to_string(kVersion);
+    return false;
+  }
+  out.job_id = rd.get<uint64_t>();
+  out.tile = rd.get<uint32_t>();
+  out.pass = rd.get<uint32_t>();
+  TileRect rect;
+  rect.x0 = rd.get<int32_t>();
+  rect.y0 = rd.get<int32_t>();
+  rect.x1 = rd.get<int32_t>();
+  rect.y1 = rd.get<int32_t>();
+  if (rect.empty() || rect.x0 < 0 || rect.y0 < 0 || rect.area() > max_pixels ||
+      raw.size() != kHeaderBytes + 32 + size_t(rect.area()) * kPixelBytes) {
+    error = "tile result: pixel data does not match the tile's rectangle";
+    return false;
+  }
+  out.sample_begin = rd.get<uint32_t>();
+  out.sample_end = rd.get<uint32_t>();
+  out.film.reset(rect);
+  RenderCounters& c = out.film.counters;
+  for (uint64_t* v : {&c.samples, &c.camera_rays, &c.bounce_rays, &c.shadow_rays, &c.nonfinite}) *v = rd.get<uint64_t>();
+  out.seconds = rd.get<double>();
+  for (PixelSums& px : out.film.mutable_pixels()) {
+    for (double& v : px.sum) v = rd.get<double>();
+    for (double& v : px.sum_sq) v = rd.get<double>();
+    px.count = rd.get<uint64_t>();
+  }
+  return true;
+}
+
+}  // namespace tessera

@@ -1,0 +1,83 @@
+// The coordinator's services: scenes, jobs, workers and leases. HTTP handlers (http_api.cpp) only
+// parse a request, call one of these and map the Result; the tests call them directly too.
+//
+// Work unit = (tile, pass). Units are leased pass-major (every tile's first pass before any second
+// pass: a quick preview of the whole frame), jobs by priority then submission. A tile's passes are
+// added to the job's Film in pass order whatever order they arrive in, which keeps the stitched
+// image bit-identical to `tessera render` (render/renderer.h).
+#pragma once
+
+#include "tessera/farm/bundle.h"
+#include "tessera/farm/protocol.h"
+#include "tessera/server/status.h"
+
+#include <nlohmann/json.hpp>
+
+#include <memory>
+#include <string>
+#include <string_view>
+
+namespace tessera::server {
+
+struct CoordinatorOptions {
+  std::string data_dir = "tessera-data";
+  double lease_timeout = 30;      // seconds without a heartbeat before a lease is re-issued
+  double max_poll_wait = 30;      // upper bound of a lease long poll
+  int max_waiting_polls = 16;     // concurrent long polls; more get 204 at once (never starve clients)
+  int worker_failure_limit = 2;   // failures of one worker on one job before it is kept off the job
+  int failed_workers_limit = 3;   // distinct workers failing a job before the job fails
+  JobLimits limits;
+  BundleLimits bundle_limits;
+  uint64_t max_upload_bytes = uint64_t(4) << 30;
+};
+
+struct ImageBytes {
+  std::string bytes, content_type;
+};
+
+class Coordinator {
+ public:
+  /// Opens the data directory and resumes every unfinished job. Throws std::runtime_error with the
+  /// reason if the data directory cannot be used.
+  explicit Coordinator(CoordinatorOptions options);
+  ~Coordinator();
+  Coordinator(const Coordinator&) = delete;
+  Coordinator& operator=(const Coordinator&) = delete;
+
+  const CoordinatorOptions& options() const;
+
+  // Scenes: bundles stored content-addressed by SHA-256.
+  Result<nlohmann::json> upload_scene(const std::string& bundle);
+  /// Path of the stored bundle file.
+  Result<std::string> scene_bundle_path(const std::string& hash);
+
+  // Jobs. `bundle` non-empty: uploaded in the same request (the settings' scene may be empty).
+  Result<nlohmann::json> submit_job(const nlohmann::json& settings, const std::string& bundle);
+  Result<nlohmann::json> job_status(uint64_t id);
+  Result<nlohmann::json> list_jobs();
+  /// format: exr, png or pfm. The partial image while running.
+  Result<ImageBytes> job_image(uint64_t id, const std::string& format);
+  Status cancel_job(uint64_t id);
+
+  // Workers.
+  Result<nlohmann::json> register_worker(const nlohmann::json& hello);
+  /// Waits up to `wait_seconds` (bounded by max_poll_wait) for work. A null json: nothing to do.
+  Result<nlohmann::json> lease(uint64_t worker, double wait_seconds);
+  Result<nlohmann::json> heartbeat(uint64_t worker, const nlohmann::json& body);
+  /// A tile result (tile_result.h bytes). Accepted once per unit: a duplicate is acknowledged and
+  /// dropped. Valid without a live lease too (a worker finishing across a coordinator restart).
+  Result<nlohmann::json> upload_result(uint64_t worker, uint64_t lease, std::string_view bytes);
+  Status fail_lease(uint64_t worker, uint64_t lease, const nlohmann::json& body);
+  Status sign_off(uint64_t worker, const nlohmann::json& body);
+  Result<nlohmann::json> list_workers();
+
+  nlohmann::json health();
+  /// Wakes every long poll and refuses new ones (503); called on SIGTERM.
+  void shutdown();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace tessera::server

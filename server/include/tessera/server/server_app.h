@@ -1,0 +1,27 @@
+// `tessera-server`: options, the HTTP server, local workers and signal handling. main.cpp only
+// calls server_main().
+#pragma once
+
+#include "tessera/server/coordinator.h"
+
+#include <string>
+
+namespace tessera::server {
+
+struct ServerOptions {
+  std::string listen = "127.0.0.1:8420";  // HOST:PORT; port 0 picks a free one
+  std::string port_file;                  // write the bound port here (for scripts and tests)
+  int http_threads = 32;                  // cpp-httplib thread pool
+  int local_workers = 0;
+  int local_worker_threads = 0;           // 0: the machine's cores divided among the local workers
+  std::string worker_binary;              // default: tessera-worker beside this program
+  CoordinatorOptions coordinator;
+};
+
+/// Parses argv (CLI11) into options; returns an exit code >= 0 when the program should stop
+/// (--help, bad flags), -1 to go on.
+int parse_server_args(int argc, char** argv, ServerOptions& options);
+/// Runs until SIGTERM/SIGINT; returns the exit code.
+int run_server(const ServerOptions& options);
+
+}  // namespace tessera::server

@@ -1,0 +1,82 @@
+// The coordinator's durable state in SQLite (WAL, synchronous=FULL): scenes, jobs, acknowledged
+// tile-pass results (as the compressed bytes the worker sent), the lease log and workers.
+// A result is committed (fsync'd) before the coordinator acknowledges it, so after kill -9 every
+// acknowledged pass is still here. Methods throw StoreError; services map it to 500/507.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+struct sqlite3;
+
+namespace tessera::server {
+
+struct StoreError : std::runtime_error {
+  bool disk_full = false;
+  StoreError(const std::string& what, bool full) : std::runtime_error(what), disk_full(full) {}
+};
+
+struct JobRow {
+  uint64_t id = 0;
+  std::string name, plan_json, state, error;
+  int priority = 0;
+  double created = 0, started = 0, finished = 0;
+};
+
+struct WorkerRow {
+  uint64_t id = 0;
+  std::string name, version, isa;
+  int threads = 0;
+  uint64_t memory = 0;
+  double registered = 0;
+};
+
+struct ResultRow {
+  uint32_t tile = 0, pass = 0;
+  uint64_t worker = 0;
+  std::string data;
+};
+
+class Store {
+ public:
+  /// Opens (creating) `path`; throws StoreError.
+  explicit Store(const std::string& path);
+  ~Store();
+  Store(const Store&) = delete;
+  Store& operator=(const Store&) = delete;
+
+  void add_scene(const std::string& hash, uint64_t bytes, double now);
+  bool has_scene(const std::string& hash);
+
+  uint64_t add_job(const std::string& name, const std::string& plan_json, int priority, double now);
+  void set_job_state(uint64_t id, const std::string& state, const std::string& error, double started,
+                     double finished);
+  std::vector<JobRow> jobs();
+
+  /// Logs a lease; returns its sequence number.
+  uint64_t log_lease(uint64_t job, uint32_t tile, uint32_t pass, uint64_t worker, double now);
+  /// Commits an acknowledged result. False if (job, tile, pass) already had one (a duplicate).
+  bool add_result(uint64_t job, uint32_t tile, uint32_t pass, uint64_t worker, const std::string& data,
+                  double now);
+  /// Calls `fn` for every result of `job`, ordered by pass then tile.
+  void for_each_result(uint64_t job, const std::function<void(ResultRow&&)>& fn);
+  /// Leases issued for a pass after that pass had been acknowledged (should be 0: the measure the
+  /// restart test reads).
+  uint64_t reissued_after_ack(uint64_t job);
+  uint64_t leases_issued(uint64_t job);
+
+  uint64_t add_worker(const WorkerRow& w);
+  std::optional<WorkerRow> worker(uint64_t id);
+  void touch_worker(uint64_t id, double now, const std::string& state);
+
+ private:
+  void exec(const char* sql);
+  sqlite3* db_ = nullptr;
+};
+
+}  // namespace tessera::server

@@ -1,0 +1,148 @@
+// Construction, resume after a restart, lease expiry, health and shutdown.
+#include "coordinator_impl.h"
+
+#include "tessera/farm/tile_result.h"
+
+#include <spdlog/spdlog.h>
+
+#include <filesystem>
+
+namespace tessera::server {
+
+namespace fs = std::filesystem;
+
+double wall_seconds() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+Status internal_error(const std::exception& e) {
+  if (auto* se = dynamic_cast<const StoreError*>(&e); se && se->disk_full)
+    return make_error(Code::InsufficientStorage, "disk_full", se->what());
+  return make_error(Code::Internal, "internal", e.what());
+}
+
+int http_status(Code code) {
+  switch (code) {
+    case Code::Ok: return 200;
+    case Code::BadRequest: return 400;
+    case Code::NotFound: return 404;
+    case Code::Conflict: return 409;
+    case Code::Gone: return 410;
+    case Code::PayloadTooLarge: return 413;
+    case Code::Unprocessable: return 422;
+    case Code::Unavailable: return 503;
+    case Code::Internal: return 500;
+    case Code::InsufficientStorage: return 507;
+  }
+  return 500;
+}
+
+namespace {
+std::string prepare_data_dir(const std::string& dir) {
+  fs::create_directories(fs::path(dir) / "bundles");
+  fs::create_directories(fs::path(dir) / "scenes");
+  fs::create_directories(fs::path(dir) / "tmp");
+  return (fs::path(dir) / "state.sqlite").string();
+}
+}  // namespace
+
+Coordinator::Impl::Impl(CoordinatorOptions o)
+    : opt(std::move(o)), store(prepare_data_dir(opt.data_dir)), fingerprint(build_fingerprint()) {}
+
+std::string Coordinator::Impl::bundle_path(const std::string& hash) const {
+  return (fs::path(opt.data_dir) / "bundles" / (hash + ".bundle")).string();
+}
+std::string Coordinator::Impl::scene_dir(const std::string& hash) const {
+  return (fs::path(opt.data_dir) / "scenes" / hash).string();
+}
+
+Coordinator::Coordinator(CoordinatorOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {
+  Impl& s = *impl_;
+  // Resume: every job's acknowledged passes go back into its film; leases in flight died with the
+  // previous process, so their units are simply available again.
+  size_t resumed = 0, passes = 0;
+  for (JobRow& row : s.store.jobs()) {
+    JobPlan plan;
+    std::string error;
+    if (!job_plan_from_json(nlohmann::json::parse(row.plan_json), plan, error))
+      throw std::runtime_error("job " + std::to_string(row.id) + " in the state database: " + error);
+    auto job = std::make_unique<JobState>(row.id, std::move(plan), row.name, row.priority, row.created);
+    if (!parse_phase(row.state, job->phase)) job->phase = JobPhase::Failed;
+    job->error = row.error;
+    job->started = row.started;
+    job->finished = row.finished;
+    s.store.for_each_result(row.id, [&](ResultRow&& r) {
+      TileResult result;
+      std::string err;
+      if (!decode_tile_result(r.data, result, err))
+        throw std::runtime_error("job " + std::to_string(row.id) + ": stored result is corrupt: " + err);
+      if (r.tile < job->num_tiles() && r.pass < job->num_passes()) {
+        (void)job->add_result(job->unit(r.tile, r.pass), std::move(result.film), r.worker);
+        ++passes;
+      }
+    });
+    if (!is_terminal(job->phase)) ++resumed;
+    s.jobs.emplace(row.id, std::move(job));
+  }
+  if (!s.jobs.empty())
+    spdlog::info("coordinator: {} jobs in {}, {} resumed with {} acknowledged passes", s.jobs.size(), s.opt.data_dir,
+                 resumed, passes);
+  s.reaper = std::thread([&s] { s.reap_loop(); });
+}
+
+Coordinator::~Coordinator() {
+  shutdown();
+  if (impl_->reaper.joinable()) impl_->reaper.join();
+}
+
+const CoordinatorOptions& Coordinator::options() const { return impl_->opt; }
+
+void Coordinator::shutdown() {
+  std::lock_guard<std::mutex> lock(impl_->mu);
+  impl_->stopping = true;
+  impl_->work_cv.notify_all();
+}
+
+void Coordinator::Impl::end_lease(std::map<uint64_t, LeaseInfo>::iterator it) {
+  auto job = jobs.find(it->second.job);
+  if (job != jobs.end()) job->second->lease_ended(it->second.unit);
+  leases.erase(it);
+  work_cv.notify_all();
+}
+
+void Coordinator::Impl::save_phase(JobState& job) {
+  store.set_job_state(job.id(), phase_name(job.phase), job.error, job.started, job.finished);
+}
+
+void Coordinator::Impl::reap_loop() {
+  std::unique_lock<std::mutex> lock(mu);
+  while (!stopping) {
+    work_cv.wait_for(lock, std::chrono::milliseconds(250));
+    const auto now = Clock::now();
+    for (auto it = leases.begin(); it != leases.end();) {
+      auto next = std::next(it);
+      if (it->second.expires < now) {
+        spdlog::warn("lease {} (job {}, unit {}) of worker {} expired; re-issuing", it->first, it->second.job,
+                     it->second.unit, it->second.worker);
+        end_lease(it);
+      }
+      it = next;
+    }
+    const auto silent = std::chrono::duration<double>(opt.lease_timeout);
+    for (auto& [id, w] : workers)
+      if ((w.state == "idle" || w.state == "busy") && now - w.last_seen > silent) w.state = "lost";
+  }
+}
+
+nlohmann::json Coordinator::health() {
+  std::lock_guard<std::mutex> lock(impl_->mu);
+  size_t active = 0;
+  for (auto& [id, job] : impl_->jobs) active += !is_terminal(job->phase);
+  return {{"status", impl_->stopping ? "stopping" : "ok"},
+          {"version", impl_->fingerprint.version},
+          {"jobs_active", active},
+          {"leases", impl_->leases.size()},
+          {"uptime_seconds", std::chrono::duration<double>(Clock::now() - impl_->started).count()}};
+}
+
+}  // namespace tessera::server

@@ -1,0 +1,69 @@
+// The coordinator's shared state (one mutex guards all of it; SQLite writes happen under it,
+// which serialises them as SQLite would anyway).
+#pragma once
+
+#include "job_state.h"
+#include "tessera/farm/build_fingerprint.h"
+#include "tessera/server/coordinator.h"
+#include "tessera/server/store.h"
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <map>
+#include <mutex>
+#include <thread>
+
+namespace tessera::server {
+
+using Clock = std::chrono::steady_clock;
+
+struct LeaseInfo {
+  uint64_t id = 0, job = 0, worker = 0;
+  size_t unit = 0;
+  Clock::time_point expires;
+};
+
+struct WorkerInfo {
+  WorkerRow row;
+  Clock::time_point last_seen;
+  std::string state = "idle";  // idle, busy, lost, gone
+  uint64_t units_done = 0, samples_done = 0;
+  double render_seconds = 0;
+};
+
+struct Coordinator::Impl {
+  explicit Impl(CoordinatorOptions o);
+
+  CoordinatorOptions opt;
+  Store store;
+  BuildFingerprint fingerprint;
+
+  std::mutex mu;
+  std::condition_variable work_cv;  // new work, a lease expired, a job resumed, shutdown
+  std::map<uint64_t, std::unique_ptr<JobState>> jobs;
+  std::map<uint64_t, LeaseInfo> leases;
+  std::map<uint64_t, WorkerInfo> workers;
+  std::atomic<int> waiting_polls{0};
+  bool stopping = false;
+  std::thread reaper;
+  Clock::time_point started = Clock::now();
+
+  std::string bundle_path(const std::string& hash) const;
+  std::string scene_dir(const std::string& hash) const;
+  /// Under `mu`: the worker, loaded from the store after a restart; null if unknown.
+  WorkerInfo* find_worker(uint64_t id);
+  /// Under `mu`: ends a lease (the unit becomes available again unless done).
+  void end_lease(std::map<uint64_t, LeaseInfo>::iterator it);
+  /// Under `mu`: persists a job's phase.
+  void save_phase(JobState& job);
+  /// Under `mu`: job status as JSON.
+  nlohmann::json status_json(const JobState& job);
+  /// Expires leases and marks silent workers lost, once a second.
+  void reap_loop();
+};
+
+double wall_seconds();
+Status internal_error(const std::exception& e);
+
+}  // namespace tessera::server

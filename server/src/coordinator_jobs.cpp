@@ -1,0 +1,291 @@
+// Scenes and jobs: upload, submit (the scene is loaded here, so a broken one fails the request),
+// status, image, cancel.
+#include "coordinator_impl.h"
+
+#include "tessera/farm/sha256.h"
+#include "tessera/image/image.h"
+#include "tessera/scene/error.h"
+
+#include <spdlog/spdlog.h>
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+namespace tessera::server {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+// Written to a temporary name, fsync'd, renamed, directory fsync'd: after a crash the file is
+// either complete or absent.
+void write_file_durably(const std::string& path, const std::string& bytes) {
+  const std::string tmp = path + ".tmp";
+  int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw StoreError("cannot create " + tmp + ": " + std::strerror(errno), errno == ENOSPC);
+  size_t off = 0;
+  while (off < bytes.size()) {
+    ssize_t n = ::write(fd, bytes.data() + off, bytes.size() - off);
+    if (n < 0) {
+      int err = errno;
+      ::close(fd);
+      ::unlink(tmp.c_str());
+      throw StoreError("cannot write " + tmp + ": " + std::strerror(err), err == ENOSPC);
+    }
+    off += size_t(n);
+  }
+  if (::fsync(fd) != 0 || ::close(fd) != 0) {
+    int err = errno;
+    ::unlink(tmp.c_str());
+    throw StoreError("cannot sync " + tmp + ": " + std::strerror(err), err == ENOSPC);
+  }
+  fs::rename(tmp, path);
+  int dir = ::open(fs::path(path).parent_path().c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dir >= 0) {
+    ::fsync(dir);
+    ::close(dir);
+  }
+}
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read " + path);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Loader messages name files by their path in the data directory; users know them by their path
+// in the bundle.
+std::string strip_dir(std::string msg, const std::string& dir) {
+  for (const std::string& prefix : {fs::weakly_canonical(dir).string() + "/", dir + "/"})
+    for (size_t at; (at = msg.find(prefix)) != std::string::npos;) msg.erase(at, prefix.size());
+  return msg;
+}
+
+std::mutex unpack_mutex;  // one unpack per bundle at a time
+
+}  // namespace
+
+Result<json> Coordinator::upload_scene(const std::string& bundle) {
+  Impl& s = *impl_;
+  if (bundle.size() > s.opt.max_upload_bytes)
+    return make_error(Code::PayloadTooLarge, "bundle_too_large",
+                      "the bundle has " + std::to_string(bundle.size()) + " bytes; the limit is " +
+                          std::to_string(s.opt.max_upload_bytes));
+  BundleResult inspected = inspect_bundle(bundle, s.opt.bundle_limits);
+  if (!inspected.ok()) return make_error(Code::BadRequest, "bad_bundle", inspected.error);
+  const std::string hash = sha256_hex(bundle);
+  try {
+    if (!fs::exists(s.bundle_path(hash))) write_file_durably(s.bundle_path(hash), bundle);
+    std::lock_guard<std::mutex> lock(s.mu);
+    s.store.add_scene(hash, bundle.size(), wall_seconds());
+  } catch (const std::exception& e) {
+    return internal_error(e);
+  }
+  json files = json::array();
+  for (const BundleEntry& e : inspected.files) files.push_back(e.path);
+  return json{{"hash", hash}, {"bytes", bundle.size()}, {"files", files}};
+}
+
+Result<std::string> Coordinator::scene_bundle_path(const std::string& hash) {
+  if (!is_sha256_hex(hash)) return make_error(Code::BadRequest, "bad_hash", "'" + hash + "' is not a SHA-256 hash");
+  std::string path = impl_->bundle_path(hash);
+  if (!fs::exists(path)) return make_error(Code::NotFound, "unknown_scene", "no scene bundle " + hash);
+  return path;
+}
+
+Result<json> Coordinator::submit_job(const json& body, const std::string& bundle) {
+  Impl& s = *impl_;
+  JobSettings settings;
+  std::string error;
+  if (!job_settings_from_json(body, settings, error, bundle.empty()))
+    return make_error(Code::BadRequest, "bad_settings", error);
+  if (!bundle.empty()) {
+    Result<json> uploaded = upload_scene(bundle);
+    if (!uploaded.ok()) return uploaded.status;
+    settings.scene = uploaded.value["hash"].get<std::string>();
+  }
+  if (!check_job_limits(settings, s.opt.limits, error)) return make_error(Code::Unprocessable, "bad_settings", error);
+  Result<std::string> path = scene_bundle_path(settings.scene);
+  if (!path.ok()) return path.status;
+
+  const std::string dir = s.scene_dir(settings.scene);
+  JobPlan plan;
+  try {
+    std::vector<BundleEntry> entries;
+    {
+      std::lock_guard<std::mutex> lock(unpack_mutex);
+      BundleResult unpacked = fs::exists(dir) ? inspect_bundle(read_file(path.value), s.opt.bundle_limits)
+                                              : unpack_bundle(read_file(path.value), dir, s.opt.bundle_limits);
+      if (!unpacked.ok()) return make_error(Code::BadRequest, "bad_bundle", unpacked.error);
+      entries = std::move(unpacked.files);
+    }
+    std::string scene_file = find_scene_xml(entries, settings.scene_file, error);
+    if (scene_file.empty()) return make_error(Code::Unprocessable, "no_scene_file", error);
+    LoadedJobScene loaded = load_job_scene(dir, scene_file, settings);
+    plan = make_job_plan(dir, scene_file, settings, loaded);
+  } catch (const UnsupportedError& e) {
+    return make_error(Code::Unprocessable, "scene_unsupported", strip_dir(e.what(), dir));
+  } catch (const SceneError& e) {
+    return make_error(Code::Unprocessable, "scene_load_failed", strip_dir(e.what(), dir));
+  } catch (const std::exception& e) {
+    return make_error(Code::Unprocessable, "scene_load_failed", strip_dir(e.what(), dir));
+  }
+  if (!check_job_limits(plan.settings, s.opt.limits, error)) return make_error(Code::Unprocessable, "bad_settings", error);
+
+  std::lock_guard<std::mutex> lock(s.mu);
+  if (s.stopping) return make_error(Code::Unavailable, "stopping", "the coordinator is shutting down");
+  try {
+    const double now = wall_seconds();
+    uint64_t id = s.store.add_job(settings.name, to_json(plan).dump(), settings.priority, now);
+    auto job = std::make_unique<JobState>(id, std::move(plan), settings.name, settings.priority, now);
+    spdlog::info("job {} submitted: '{}', {}x{}, {} spp, {} tiles x {} passes", id, settings.name,
+                 job->plan().window.width(), job->plan().window.height(), job->plan().settings.spp, job->num_tiles(),
+                 job->num_passes());
+    json status = s.status_json(*job);
+    s.jobs.emplace(id, std::move(job));
+    s.work_cv.notify_all();
+    return status;
+  } catch (const std::exception& e) {
+    return internal_error(e);
+  }
+}
+
+json Coordinator::Impl::status_json(const JobState& job) {
+  const double now = wall_seconds();
+  const double end = job.finished > 0 ? job.finished : now;
+  const double elapsed = job.started > 0 ? end - job.started : 0;
+  const double fraction = job.total_samples() ? double(job.done_samples()) / double(job.total_samples()) : 1;
+  json workers_json = json::array();
+  for (auto& [wid, samples] : job.samples_by_worker()) {
+    auto w = workers.find(wid);
+    workers_json.push_back({{"id", wid},
+                            {"name", w != workers.end() ? w->second.row.name : ""},
+                            {"samples", samples},
+                            {"share", job.done_samples() ? double(samples) / double(job.done_samples()) : 0}});
+  }
+  const JobPlan& p = job.plan();
+  json j = {{"id", job.id()},
+            {"name", job.name()},
+            {"state", phase_name(job.phase)},
+            {"priority", job.priority()},
+            {"error", job.error},
+            {"settings", to_json(p.settings)},
+            {"scene_file", p.scene_file},
+            {"width", p.window.width()},
+            {"height", p.window.height()},
+            {"spp", p.settings.spp},
+            {"tiles", job.num_tiles()},
+            {"passes", job.num_passes()},
+            {"units_done", job.done_units()},
+            {"units_total", job.num_units()},
+            {"samples_done", job.done_samples()},
+            {"samples_total", job.total_samples()},
+            {"progress", fraction},
+            {"elapsed_seconds", elapsed},
+            {"eta_seconds", fraction > 0 && fraction < 1 ? elapsed * (1 - fraction) / fraction : 0.0},
+            {"created", job.created()},
+            {"workers", workers_json},
+            {"duplicate_results", job.duplicates},
+            {"nonfinite_samples", job.counters().nonfinite}};
+  try {
+    j["leases_issued"] = store.leases_issued(job.id());
+    j["reissued_acknowledged_passes"] = store.reissued_after_ack(job.id());
+  } catch (const std::exception&) {
+  }
+  return j;
+}
+
+Result<json> Coordinator::job_status(uint64_t id) {
+  std::lock_guard<std::mutex> lock(impl_->mu);
+  auto it = impl_->jobs.find(id);
+  if (it == impl_->jobs.end()) return make_error(Code::NotFound, "unknown_job", "no job " + std::to_string(id));
+  return impl_->status_json(*it->second);
+}
+
+Result<json> Coordinator::list_jobs() {
+  std::lock_guard<std::mutex> lock(impl_->mu);
+  json list = json::array();
+  for (auto& [id, job] : impl_->jobs) {
+    json j = impl_->status_json(*job);
+    list.push_back({{"id", id}, {"name", j["name"]}, {"state", j["state"]}, {"priority", j["priority"]},
+                    {"progress", j["progress"]}, {"width", j["width"]}, {"height", j["height"]}, {"spp", j["spp"]},
+                    {"error", j["error"]}});
+  }
+  return json{{"jobs", list}};
+}
+
+Result<ImageBytes> Coordinator::job_image(uint64_t id, const std::string& format) {
+  Impl& s = *impl_;
+  if (format != "exr" && format != "png" && format != "pfm")
+    return make_error(Code::BadRequest, "bad_format", "format '" + format + "' is not exr, png or pfm");
+  Image image;
+  JobPlan plan;
+  {
+    std::lock_guard<std::mutex> lock(s.mu);
+    auto it = s.jobs.find(id);
+    if (it == s.jobs.end()) return make_error(Code::NotFound, "unknown_job", "no job " + std::to_string(id));
+    image = it->second->image();
+    plan = it->second->plan();
+  }
+  static std::atomic<uint64_t> counter{0};
+  const std::string tmp = (fs::path(s.opt.data_dir) / "tmp" /
+                           ("image-" + std::to_string(::getpid()) + "-" + std::to_string(++counter) + "." + format))
+                              .string();
+  try {
+    if (format == "png") {
+      LdrSettings ldr;
+      if (plan.ldr) {
+        ldr.gamma = plan.gamma;
+        ldr.exposure = plan.exposure;
+      }
+      write_png(tmp, image, ldr);
+    } else {
+      write_image(tmp, image,
+                  {{"tessera_version", TESSERA_VERSION},
+                   {"tessera_job", std::to_string(id)},
+                   {"tessera_spp", std::to_string(plan.settings.spp)},
+                   {"tessera_seed", std::to_string(plan.settings.seed)}});
+    }
+    ImageBytes out{read_file(tmp), format == "png" ? "image/png" : format == "exr" ? "image/x-exr" : "image/x-pfm"};
+    fs::remove(tmp);
+    return out;
+  } catch (const std::exception& e) {
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    return internal_error(e);
+  }
+}
+
+Status Coordinator::cancel_job(uint64_t id) {
+  Impl& s = *impl_;
+  std::lock_guard<std::mutex> lock(s.mu);
+  auto it = s.jobs.find(id);
+  if (it == s.jobs.end()) return make_error(Code::NotFound, "unknown_job", "no job " + std::to_string(id));
+  JobState& job = *it->second;
+  if (is_terminal(job.phase))
+    return make_error(Code::Conflict, "job_finished", "job " + std::to_string(id) + " is already " + phase_name(job.phase));
+  job.phase = JobPhase::Cancelled;
+  job.finished = wall_seconds();
+  for (auto l = s.leases.begin(); l != s.leases.end();) {
+    auto next = std::next(l);
+    if (l->second.job == id) s.end_lease(l);
+    l = next;
+  }
+  try {
+    s.save_phase(job);
+  } catch (const std::exception& e) {
+    return internal_error(e);
+  }
+  spdlog::info("job {} cancelled", id);
+  return Status::success();
+}
+
+}  // namespace tessera::server

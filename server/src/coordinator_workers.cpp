@@ -1,0 +1,309 @@
+// Workers and leases: registration (with the build check), long-poll leasing, heartbeats, results,
+// failures and sign-off.
+#include "coordinator_impl.h"
+
+#include "tessera/farm/tile_result.h"
+
+#include <spdlog/spdlog.h>
+
+namespace tessera::server {
+
+using nlohmann::json;
+
+namespace {
+Status unknown_worker(uint64_t id) {
+  return make_error(Code::NotFound, "unknown_worker", "no worker " + std::to_string(id) + "; register again");
+}
+}  // namespace
+
+WorkerInfo* Coordinator::Impl::find_worker(uint64_t id) {
+  auto it = workers.find(id);
+  if (it != workers.end()) return &it->second;
+  // After a restart: a worker registered with the previous process keeps its id.
+  std::optional<WorkerRow> row = store.worker(id);
+  if (!row) return nullptr;
+  WorkerInfo& w = workers[id];
+  w.row = *row;
+  w.last_seen = Clock::now();
+  return &w;
+}
+
+Result<json> Coordinator::register_worker(const json& body) {
+  Impl& s = *impl_;
+  WorkerHello hello;
+  std::string error;
+  if (!worker_hello_from_json(body, hello, error)) return make_error(Code::BadRequest, "bad_registration", error);
+  std::string mismatch =
+      fingerprint_mismatch(s.fingerprint, BuildFingerprint{hello.version, hello.isa, hello.probe});
+  if (!mismatch.empty()) {
+    spdlog::warn("refused worker '{}': {}", hello.name, mismatch);
+    return make_error(Code::Conflict, "incompatible_worker", mismatch);
+  }
+  std::lock_guard<std::mutex> lock(s.mu);
+  try {
+    WorkerRow row{0, hello.name, hello.version, hello.isa, hello.threads, hello.memory_bytes, wall_seconds()};
+    row.id = s.store.add_worker(row);
+    WorkerInfo& w = s.workers[row.id];
+    w.row = row;
+    w.last_seen = Clock::now();
+    spdlog::info("worker {} registered: '{}', {} threads, {}", row.id, hello.name, hello.threads, hello.isa);
+    return json{{"id", row.id},
+                {"lease_timeout", s.opt.lease_timeout},
+                {"heartbeat_seconds", s.opt.lease_timeout / 4},
+                {"max_poll_wait", s.opt.max_poll_wait}};
+  } catch (const std::exception& e) {
+    return internal_error(e);
+  }
+}
+
+Result<json> Coordinator::lease(uint64_t worker, double wait_seconds) {
+  Impl& s = *impl_;
+  // Bounded: beyond this many waiting polls the answer is "nothing now" at once, so waiting
+  // workers can never occupy every HTTP thread.
+  // The slot is taken atomically, so concurrent polls cannot all pass the check at once.
+  struct PollSlot {
+    std::atomic<int>& n;
+    ~PollSlot() { --n; }
+  } slot{s.waiting_polls};
+  if (s.waiting_polls.fetch_add(1) >= s.opt.max_waiting_polls) wait_seconds = 0;
+  std::unique_lock<std::mutex> lock(s.mu);
+  WorkerInfo* w = s.find_worker(worker);
+  if (!w) return unknown_worker(worker);
+  w->last_seen = Clock::now();
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
+                                           std::clamp(wait_seconds, 0.0, s.opt.max_poll_wait)));
+  for (;;) {
+    if (s.stopping) return make_error(Code::Unavailable, "stopping", "the coordinator is shutting down");
+    JobState* best = nullptr;
+    size_t unit = 0;
+    for (auto& [id, job] : s.jobs) {
+      if (is_terminal(job->phase)) continue;
+      if (best && (job->priority() < best->priority())) continue;
+      if (best && job->priority() == best->priority()) continue;  // same priority: earlier job first
+      auto f = job->failures_by_worker.find(worker);
+      if (f != job->failures_by_worker.end() && f->second >= s.opt.worker_failure_limit) continue;
+      if (std::optional<size_t> u = job->next_unit()) {
+        best = job.get();
+        unit = *u;
+      }
+    }
+    if (best) {
+      try {
+        const double now = wall_seconds();
+        Lease l;
+        l.id = s.store.log_lease(best->id(), best->tile_of(unit), best->pass_of(unit), worker, now);
+        l.job_id = best->id();
+        l.tile = best->tile_of(unit);
+        l.pass = best->pass_of(unit);
+        l.rect = best->rect(unit);
+        l.sample_begin = best->sample_begin(unit);
+        l.sample_end = best->sample_end(unit);
+        l.seconds_to_expiry = s.opt.lease_timeout;
+        l.settings = best->plan().settings;
+        l.scene_file = best->plan().scene_file;
+        l.files = best->plan().files;
+        best->lease_started(unit);
+        s.leases[l.id] = LeaseInfo{l.id, l.job_id, worker, unit,
+                                   Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                                      std::chrono::duration<double>(s.opt.lease_timeout))};
+        if (best->phase == JobPhase::Queued) {
+          best->phase = JobPhase::Running;
+          best->started = now;
+          s.save_phase(*best);
+        }
+        w->state = "busy";
+        return to_json(l);
+      } catch (const std::exception& e) {
+        return internal_error(e);
+      }
+    }
+    if (Clock::now() >= deadline) break;
+    s.work_cv.wait_until(lock, deadline);
+  }
+  if (w->state == "busy") {
+    bool holds = false;
+    for (auto& [id, l] : s.leases) holds |= l.worker == worker;
+    if (!holds) w->state = "idle";
+  }
+  return json();
+}
+
+Result<json> Coordinator::heartbeat(uint64_t worker, const json& body) {
+  Impl& s = *impl_;
+  std::lock_guard<std::mutex> lock(s.mu);
+  WorkerInfo* w = s.find_worker(worker);
+  if (!w) return unknown_worker(worker);
+  w->last_seen = Clock::now();
+  if (w->state == "lost") w->state = "busy";
+  json drop = json::array();
+  auto leases = body.is_object() ? body.find("leases") : body.end();
+  if (body.is_object() && leases != body.end() && leases->is_array()) {
+    for (const json& item : *leases) {
+      if (!item.is_object() || !item.contains("id") || !item["id"].is_number_unsigned()) continue;
+      const uint64_t id = item["id"].get<uint64_t>();
+      auto it = s.leases.find(id);
+      if (it != s.leases.end() && it->second.worker == worker) {
+        auto job = s.jobs.find(it->second.job);
+        if (job != s.jobs.end() && job->second->is_done(it->second.unit)) {
+          drop.push_back(id);  // someone else delivered it first
+          s.end_lease(it);
+          continue;
+        }
+        it->second.expires = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                                std::chrono::duration<double>(s.opt.lease_timeout));
+        continue;
+      }
+      // Unknown (a lease from before a coordinator restart): keep it if its work is still wanted.
+      uint64_t job_id = item.value("job", uint64_t(0));
+      uint32_t tile = item.value("tile", 0u), pass = item.value("pass", 0u);
+      auto job = s.jobs.find(job_id);
+      if (job == s.jobs.end() || is_terminal(job->second->phase) || tile >= job->second->num_tiles() ||
+          pass >= job->second->num_passes() || job->second->is_done(job->second->unit(tile, pass))) {
+        drop.push_back(id);
+        continue;
+      }
+      size_t unit = job->second->unit(tile, pass);
+      job->second->lease_started(unit);
+      s.leases[id] = LeaseInfo{id, job_id, worker, unit,
+                               Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                                  std::chrono::duration<double>(s.opt.lease_timeout))};
+    }
+  }
+  return json{{"drop", drop}};
+}
+
+Result<json> Coordinator::upload_result(uint64_t worker, uint64_t lease, std::string_view bytes) {
+  Impl& s = *impl_;
+  TileResult result;
+  std::string error;
+  if (!decode_tile_result(bytes, result, error, s.opt.limits.max_pixels))
+    return make_error(Code::BadRequest, "bad_result", error);
+  std::lock_guard<std::mutex> lock(s.mu);
+  WorkerInfo* w = s.find_worker(worker);
+  if (!w) return unknown_worker(worker);
+  w->last_seen = Clock::now();
+  auto it = s.jobs.find(result.job_id);
+  if (it == s.jobs.end()) return make_error(Code::NotFound, "unknown_job", "no job " + std::to_string(result.job_id));
+  JobState& job = *it->second;
+  if (job.phase == JobPhase::Cancelled || job.phase == JobPhase::Failed)
+    return make_error(Code::Gone, "job_ended", "job " + std::to_string(job.id()) + " is " + phase_name(job.phase));
+  if (result.tile >= job.num_tiles() || result.pass >= job.num_passes())
+    return make_error(Code::BadRequest, "bad_result", "tile or pass out of range for job " + std::to_string(job.id()));
+  const size_t unit = job.unit(result.tile, result.pass);
+  if (!(result.film.rect() == job.rect(unit)) || result.sample_begin != job.sample_begin(unit) ||
+      result.sample_end != job.sample_end(unit))
+    return make_error(Code::BadRequest, "bad_result", "the result's rectangle or samples do not match the unit");
+  for (auto l = s.leases.begin(); l != s.leases.end();) {
+    auto next = std::next(l);
+    if (l->second.job == job.id() && l->second.unit == unit && l->second.worker == worker) s.end_lease(l);
+    l = next;
+  }
+  if (job.is_done(unit)) {
+    ++job.duplicates;
+    return json{{"accepted", false}, {"duplicate", true}};
+  }
+  try {
+    // Durable before it is acknowledged: the commit fsyncs the WAL.
+    if (!s.store.add_result(job.id(), result.tile, result.pass, worker, std::string(bytes), wall_seconds())) {
+      ++job.duplicates;
+      return json{{"accepted", false}, {"duplicate", true}};
+    }
+  } catch (const std::exception& e) {
+    return internal_error(e);
+  }
+  const uint64_t samples = job.unit_samples(unit);
+  (void)job.add_result(unit, std::move(result.film), worker);
+  w->units_done += 1;
+  w->samples_done += samples;
+  w->render_seconds += result.seconds;
+  if (job.done_units() == job.num_units()) {
+    job.phase = JobPhase::Done;
+    job.finished = wall_seconds();
+    try {
+      s.save_phase(job);
+    } catch (const std::exception& e) {
+      return internal_error(e);
+    }
+    spdlog::info("job {} done in {:.2f} s", job.id(), job.finished - job.started);
+  }
+  (void)lease;
+  return json{{"accepted", true}, {"duplicate", false}};
+}
+
+Status Coordinator::fail_lease(uint64_t worker, uint64_t lease, const json& body) {
+  Impl& s = *impl_;
+  std::lock_guard<std::mutex> lock(s.mu);
+  auto it = s.leases.find(lease);
+  if (it == s.leases.end() || it->second.worker != worker)
+    return make_error(Code::NotFound, "unknown_lease", "worker " + std::to_string(worker) + " holds no lease " +
+                                                           std::to_string(lease));
+  auto job_it = s.jobs.find(it->second.job);
+  s.end_lease(it);
+  if (job_it == s.jobs.end()) return Status::success();
+  JobState& job = *job_it->second;
+  std::string reason = body.is_object() && body.contains("error") && body["error"].is_string()
+                           ? body["error"].get<std::string>().substr(0, 2000)
+                           : "unspecified";
+  ++job.failures_by_worker[worker];
+  job.last_failure = reason;
+  spdlog::warn("job {}: worker {} failed a pass: {}", job.id(), worker, reason);
+  // The job fails when its work fails on several workers (or on every worker there is).
+  size_t live = 0;
+  for (auto& [id, w] : s.workers) live += w.state == "idle" || w.state == "busy";
+  const size_t needed = std::max<size_t>(1, std::min<size_t>(size_t(s.opt.failed_workers_limit), live));
+  if (!is_terminal(job.phase) && job.failures_by_worker.size() >= needed) {
+    job.phase = JobPhase::Failed;
+    job.finished = wall_seconds();
+    job.error = "failed on " + std::to_string(job.failures_by_worker.size()) + " worker(s); last error: " + reason;
+    for (auto l = s.leases.begin(); l != s.leases.end();) {
+      auto next = std::next(l);
+      if (l->second.job == job.id()) s.end_lease(l);
+      l = next;
+    }
+    spdlog::error("job {} failed: {}", job.id(), job.error);
+  }
+  try {
+    s.save_phase(job);
+  } catch (const std::exception& e) {
+    return internal_error(e);
+  }
+  return Status::success();
+}
+
+Status Coordinator::sign_off(uint64_t worker, const json& body) {
+  Impl& s = *impl_;
+  std::lock_guard<std::mutex> lock(s.mu);
+  WorkerInfo* w = s.find_worker(worker);
+  if (!w) return unknown_worker(worker);
+  for (auto l = s.leases.begin(); l != s.leases.end();) {
+    auto next = std::next(l);
+    if (l->second.worker == worker) s.end_lease(l);
+    l = next;
+  }
+  w->state = "gone";
+  try {
+    s.store.touch_worker(worker, wall_seconds(), "gone");
+  } catch (const std::exception& e) {
+    return internal_error(e);
+  }
+  spdlog::info("worker {} signed off", worker);
+  return Status::success();
+}
+
+Result<json> Coordinator::list_workers() {
+  Impl& s = *impl_;
+  std::lock_guard<std::mutex> lock(s.mu);
+  json list = json::array();
+  for (auto& [id, w] : s.workers) {
+    list.push_back({{"id", id},
+                    {"name", w.row.name},
+                    {"threads", w.row.threads},
+                    {"state", w.state},
+                    {"units_done", w.units_done},
+                    {"samples_done", w.samples_done},
+                    {"samples_per_second", w.render_seconds > 0 ? double(w.samples_done) / w.render_seconds : 0.0}});
+  }
+  return json{{"workers", list}};
+}
+
+}  // namespace tessera::server

@@ -1,0 +1,185 @@
+#include "tessera/server/http_api.h"
+
+#include <httplib.h>
+#include <spdlog/spdlog.h>
+
+#include <fstream>
+#include <sstream>
+
+namespace tessera::server {
+
+using nlohmann::json;
+
+namespace {
+
+void send_json(httplib::Response& res, int status, const json& body) {
+  res.status = status;
+  res.set_content(body.dump(2) + "\n", "application/json");
+}
+
+void send_error(httplib::Response& res, const Status& s) {
+  send_json(res, http_status(s.code), json{{"error", s.error}, {"detail", s.detail}});
+}
+
+template <class T>
+void send(httplib::Response& res, const Result<T>& r, int ok_status = 200) {
+  if (!r.ok()) return send_error(res, r.status);
+  send_json(res, ok_status, r.value);
+}
+
+void send(httplib::Response& res, const Status& s, int ok_status = 200) {
+  if (!s.ok()) return send_error(res, s);
+  send_json(res, ok_status, json{{"ok", true}});
+}
+
+// A JSON body; an empty body is {} (for POSTs that need nothing).
+bool parse_body(const httplib::Request& req, httplib::Response& res, json& out) {
+  if (req.body.empty()) {
+    out = json::object();
+    return true;
+  }
+  out = json::parse(req.body, nullptr, false);
+  if (out.is_discarded()) {
+    send_error(res, make_error(Code::BadRequest, "bad_json", "the request body is not valid JSON"));
+    return false;
+  }
+  return true;
+}
+
+bool parse_id(const httplib::Request& req, size_t group, uint64_t& id, httplib::Response& res) {
+  try {
+    id = std::stoull(req.matches[group].str());
+    return true;
+  } catch (const std::exception&) {
+    send_error(res, make_error(Code::BadRequest, "bad_id", "'" + req.matches[group].str() + "' is not an id"));
+    return false;
+  }
+}
+
+double query_number(const httplib::Request& req, const char* name, double def) {
+  if (!req.has_param(name)) return def;
+  try {
+    return std::stod(req.get_param_value(name));
+  } catch (const std::exception&) {
+    return def;
+  }
+}
+
+// A bundle arrives as a raw body (curl --data-binary) or as the multipart field "bundle".
+std::string bundle_of(const httplib::Request& req) {
+  if (req.is_multipart_form_data()) return req.has_file("bundle") ? req.get_file_value("bundle").content : "";
+  return req.body;
+}
+
+}  // namespace
+
+void install_routes(httplib::Server& http, Coordinator& c) {
+  http.Get("/healthz", [&c](const httplib::Request&, httplib::Response& res) { send_json(res, 200, c.health()); });
+
+  http.Post("/api/v1/scenes", [&c](const httplib::Request& req, httplib::Response& res) {
+    std::string bundle = bundle_of(req);
+    if (bundle.empty())
+      return send_error(res, make_error(Code::BadRequest, "no_bundle", "send the bundle as the body or field 'bundle'"));
+    send(res, c.upload_scene(bundle), 201);
+  });
+  http.Get(R"(/api/v1/scenes/([0-9a-f]{64}))", [&c](const httplib::Request& req, httplib::Response& res) {
+    Result<std::string> path = c.scene_bundle_path(req.matches[1].str());
+    if (!path.ok()) return send_error(res, path.status);
+    std::ifstream in(path.value, std::ios::binary);
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    res.set_content(ss.str(), "application/octet-stream");
+  });
+
+  http.Post("/api/v1/jobs", [&c](const httplib::Request& req, httplib::Response& res) {
+    json settings;
+    std::string bundle;
+    if (req.is_multipart_form_data()) {
+      settings = req.has_file("settings") ? json::parse(req.get_file_value("settings").content, nullptr, false)
+                                          : json::object();
+      if (settings.is_discarded())
+        return send_error(res, make_error(Code::BadRequest, "bad_json", "field 'settings' is not valid JSON"));
+      bundle = bundle_of(req);
+    } else if (!parse_body(req, res, settings)) {
+      return;
+    }
+    send(res, c.submit_job(settings, bundle), 201);
+  });
+  http.Get("/api/v1/jobs", [&c](const httplib::Request&, httplib::Response& res) { send(res, c.list_jobs()); });
+  http.Get(R"(/api/v1/jobs/(\d+))", [&c](const httplib::Request& req, httplib::Response& res) {
+    uint64_t id;
+    if (parse_id(req, 1, id, res)) send(res, c.job_status(id));
+  });
+  http.Get(R"(/api/v1/jobs/(\d+)/image)", [&c](const httplib::Request& req, httplib::Response& res) {
+    uint64_t id;
+    if (!parse_id(req, 1, id, res)) return;
+    Result<ImageBytes> image = c.job_image(id, req.has_param("format") ? req.get_param_value("format") : "exr");
+    if (!image.ok()) return send_error(res, image.status);
+    res.set_content(image.value.bytes, image.value.content_type.c_str());
+  });
+  http.Delete(R"(/api/v1/jobs/(\d+))", [&c](const httplib::Request& req, httplib::Response& res) {
+    uint64_t id;
+    if (parse_id(req, 1, id, res)) send(res, c.cancel_job(id));
+  });
+
+  http.Post("/api/v1/workers", [&c](const httplib::Request& req, httplib::Response& res) {
+    json body;
+    if (parse_body(req, res, body)) send(res, c.register_worker(body), 201);
+  });
+  http.Get("/api/v1/workers", [&c](const httplib::Request&, httplib::Response& res) { send(res, c.list_workers()); });
+  http.Post(R"(/api/v1/workers/(\d+)/lease)", [&c](const httplib::Request& req, httplib::Response& res) {
+    uint64_t id;
+    if (!parse_id(req, 1, id, res)) return;
+    Result<json> lease = c.lease(id, query_number(req, "wait", 0));
+    if (!lease.ok()) return send_error(res, lease.status);
+    if (lease.value.is_null()) {
+      res.status = 204;
+      res.set_header("Retry-After", "1");
+      return;
+    }
+    send_json(res, 200, lease.value);
+  });
+  http.Post(R"(/api/v1/workers/(\d+)/heartbeat)", [&c](const httplib::Request& req, httplib::Response& res) {
+    uint64_t id;
+    json body;
+    if (parse_id(req, 1, id, res) && parse_body(req, res, body)) send(res, c.heartbeat(id, body));
+  });
+  http.Post(R"(/api/v1/workers/(\d+)/results)", [&c](const httplib::Request& req, httplib::Response& res) {
+    uint64_t id;
+    if (!parse_id(req, 1, id, res)) return;
+    send(res, c.upload_result(id, uint64_t(query_number(req, "lease", 0)), req.body));
+  });
+  http.Post(R"(/api/v1/workers/(\d+)/leases/(\d+)/fail)", [&c](const httplib::Request& req, httplib::Response& res) {
+    uint64_t id, lease;
+    json body;
+    if (parse_id(req, 1, id, res) && parse_id(req, 2, lease, res) && parse_body(req, res, body))
+      send(res, c.fail_lease(id, lease, body));
+  });
+  http.Delete(R"(/api/v1/workers/(\d+))", [&c](const httplib::Request& req, httplib::Response& res) {
+    uint64_t id;
+    json body;
+    if (parse_id(req, 1, id, res) && parse_body(req, res, body)) send(res, c.sign_off(id, body));
+  });
+
+  // Errors httplib produces itself (no route: 404; body over the limit: 413) get the JSON body too.
+  http.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
+    if (!res.body.empty()) return;
+    const char* error = res.status == 404 ? "not_found" : res.status == 413 ? "payload_too_large" : "http_error";
+    std::string detail = res.status == 404 ? "no such endpoint: " + req.method + " " + req.path
+                                           : "the request was refused with HTTP " + std::to_string(res.status);
+    send_json(res, res.status, json{{"error", error}, {"detail", detail}});
+  });
+  http.set_exception_handler([](const httplib::Request& req, httplib::Response& res, std::exception_ptr ep) {
+    std::string what = "unknown exception";
+    try {
+      std::rethrow_exception(ep);
+    } catch (const std::exception& e) {
+      what = e.what();
+    } catch (...) {
+    }
+    spdlog::error("{} {}: {}", req.method, req.path, what);
+    send_json(res, 500, json{{"error", "internal"}, {"detail", what}});
+  });
+}
+
+}  // namespace tessera::server

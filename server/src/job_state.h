@@ -1,0 +1,90 @@
+// One job's work in memory: its units (tile x pass), which are leased or done, and the Film the
+// finished passes are added to, each tile's passes in pass order.
+#pragma once
+
+#include "tessera/farm/job_scene.h"
+#include "tessera/image/image.h"
+#include "tessera/render/film.h"
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace tessera::server {
+
+enum class JobPhase { Queued, Running, Done, Failed, Cancelled };
+const char* phase_name(JobPhase p);
+bool parse_phase(const std::string& s, JobPhase& out);
+inline bool is_terminal(JobPhase p) { return p == JobPhase::Done || p == JobPhase::Failed || p == JobPhase::Cancelled; }
+
+class JobState {
+ public:
+  JobState(uint64_t id, JobPlan plan, std::string name, int priority, double created);
+
+  uint64_t id() const { return id_; }
+  const JobPlan& plan() const { return plan_; }
+  const std::string& name() const { return name_; }
+  int priority() const { return priority_; }
+  double created() const { return created_; }
+
+  size_t num_tiles() const { return tiles_.size(); }
+  size_t num_passes() const { return passes_.size(); }
+  size_t num_units() const { return tiles_.size() * passes_.size(); }
+  size_t done_units() const { return done_units_; }
+  uint32_t tile_of(size_t unit) const { return uint32_t(unit % tiles_.size()); }
+  uint32_t pass_of(size_t unit) const { return uint32_t(unit / tiles_.size()); }
+  size_t unit(uint32_t tile, uint32_t pass) const { return size_t(pass) * tiles_.size() + tile; }
+  const TileRect& rect(size_t unit) const { return tiles_[tile_of(unit)]; }
+  uint32_t sample_begin(size_t unit) const { return pass_begin_[pass_of(unit)]; }
+  uint32_t sample_end(size_t unit) const { return pass_begin_[pass_of(unit)] + passes_[pass_of(unit)]; }
+  /// Samples (pixels x samples per pixel) of the unit: the weight of its work.
+  uint64_t unit_samples(size_t unit) const { return uint64_t(rect(unit).area()) * (sample_end(unit) - sample_begin(unit)); }
+  uint64_t total_samples() const { return total_samples_; }
+  uint64_t done_samples() const { return done_samples_; }
+
+  /// The first unit, pass-major, that is neither done nor leased and that `worker` may take.
+  std::optional<size_t> next_unit() const;
+  void lease_started(size_t unit) { ++active_leases_[unit]; }
+  void lease_ended(size_t unit);
+  bool is_done(size_t unit) const { return done_[unit]; }
+  /// Adds a verified result; false when the unit was already done (a duplicate).
+  bool add_result(size_t unit, FilmTile&& tile, uint64_t worker);
+
+  /// Mean radiance over the film window (zero where no pass has arrived).
+  Image image() const { return film_.to_image(); }
+  const Film& film() const { return film_; }
+  const RenderCounters& counters() const { return counters_; }
+  const std::map<uint64_t, uint64_t>& samples_by_worker() const { return samples_by_worker_; }
+
+  JobPhase phase = JobPhase::Queued;
+  std::string error;
+  double started = 0, finished = 0;
+  // Failure bookkeeping: per worker, failures on this job; the reasons, for the job's error text.
+  std::map<uint64_t, int> failures_by_worker;
+  std::string last_failure;
+  uint64_t duplicates = 0;
+
+ private:
+  uint64_t id_;
+  JobPlan plan_;
+  std::string name_;
+  int priority_;
+  double created_;
+  std::vector<TileRect> tiles_;
+  std::vector<uint32_t> passes_, pass_begin_;
+  std::vector<uint8_t> done_;
+  std::vector<uint16_t> active_leases_;
+  std::vector<uint32_t> next_pass_;              // per tile: passes already in the film
+  std::map<size_t, FilmTile> waiting_;           // results that arrived before an earlier pass
+  size_t done_units_ = 0, first_open_ = 0;
+  uint64_t total_samples_ = 0, done_samples_ = 0;
+  std::map<uint64_t, uint64_t> samples_by_worker_;
+  Film film_;
+  RenderCounters counters_;
+};
+
+}  // namespace tessera::server

@@ -1,0 +1,179 @@
+#include "tessera/server/server_app.h"
+
+#include "tessera/server/http_api.h"
+
+#include <CLI/CLI.hpp>
+#include <httplib.h>
+#include <spdlog/spdlog.h>
+
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+namespace tessera::server {
+
+namespace fs = std::filesystem;
+
+int parse_server_args(int argc, char** argv, ServerOptions& o) {
+  CLI::App app{"tessera-server: the Tessera render farm coordinator"};
+  CoordinatorOptions& c = o.coordinator;
+  app.add_option("--listen", o.listen, "HOST:PORT to listen on (port 0: any free port)")->capture_default_str();
+  app.add_option("--port-file", o.port_file, "write the port actually bound to this file");
+  app.add_option("--data-dir", c.data_dir, "directory for the state database, bundles and scenes")->capture_default_str();
+  app.add_option("--http-threads", o.http_threads, "HTTP worker threads (long polls use at most half of them)")
+      ->check(CLI::Range(2, 4096))->capture_default_str();
+  app.add_option("--local-workers", o.local_workers, "also run N workers on this machine")->check(CLI::Range(0, 256));
+  app.add_option("--local-worker-threads", o.local_worker_threads, "threads per local worker (default: cores / N)");
+  app.add_option("--worker-binary", o.worker_binary, "the tessera-worker program for --local-workers");
+  app.add_option("--lease-timeout", c.lease_timeout, "seconds without a heartbeat before a lease is re-issued")
+      ->check(CLI::Range(0.5, 3600.0))->capture_default_str();
+  app.add_option("--max-poll-wait", c.max_poll_wait, "longest lease long poll, seconds")
+      ->check(CLI::Range(0.0, 30.0))->capture_default_str();
+  app.add_option("--max-upload", c.max_upload_bytes, "largest scene bundle accepted, bytes")->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  // Long polls may hold at most half the HTTP threads; the rest always serve clients.
+  c.max_waiting_polls = std::max(1, o.http_threads / 2);
+  return -1;
+}
+
+namespace {
+
+std::string find_worker_binary(const ServerOptions& o) {
+  if (!o.worker_binary.empty()) return o.worker_binary;
+  std::error_code ec;
+  fs::path self = fs::read_symlink("/proc/self/exe", ec).parent_path();
+  for (fs::path p : {self / "tessera-worker", self / ".." / "worker" / "tessera-worker"})
+    if (fs::exists(p, ec)) return p.lexically_normal().string();
+  return "tessera-worker";
+}
+
+pid_t spawn_worker(const std::string& binary, const std::string& url, int threads, int index,
+                   const std::string& cache) {
+  std::vector<std::string> args = {binary, "--server", url, "--threads", std::to_string(threads),
+                                   "--name", "local-" + std::to_string(index), "--cache-dir", cache};
+  pid_t pid = fork();
+  if (pid == 0) {
+    sigset_t none;
+    sigemptyset(&none);
+    sigprocmask(SIG_SETMASK, &none, nullptr);
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    execv(binary.c_str(), argv.data());
+    std::fprintf(stderr, "tessera-server: cannot run %s: %s\n", binary.c_str(), std::strerror(errno));
+    _exit(127);
+  }
+  return pid;
+}
+
+}  // namespace
+
+int run_server(const ServerOptions& o) {
+  // Signals are taken synchronously by this thread (sigtimedwait), so every other thread,
+  // including httplib's, runs with them blocked.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  ::signal(SIGPIPE, SIG_IGN);
+
+  size_t colon = o.listen.rfind(':');
+  if (colon == std::string::npos) {
+    std::fprintf(stderr, "tessera-server: --listen '%s': expected HOST:PORT\n", o.listen.c_str());
+    return 2;
+  }
+  const std::string host = o.listen.substr(0, colon);
+  int port = 0;
+  try {
+    port = std::stoi(o.listen.substr(colon + 1));
+  } catch (const std::exception&) {
+    std::fprintf(stderr, "tessera-server: --listen '%s': bad port\n", o.listen.c_str());
+    return 2;
+  }
+
+  std::unique_ptr<Coordinator> coordinator;
+  try {
+    coordinator = std::make_unique<Coordinator>(o.coordinator);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "tessera-server: cannot use data directory '%s': %s\n", o.coordinator.data_dir.c_str(), e.what());
+    return 1;
+  }
+
+  httplib::Server http;
+  const int threads = o.http_threads;
+  http.new_task_queue = [threads] { return new httplib::ThreadPool(size_t(threads)); };
+  // A kept-alive idle connection holds an HTTP thread; keep that short so idle clients and
+  // workers cannot pin the pool.
+  http.set_keep_alive_timeout(2);
+  http.set_read_timeout(60);
+  http.set_payload_max_length(size_t(o.coordinator.max_upload_bytes) + (size_t(16) << 20));
+  install_routes(http, *coordinator);
+  // cpp-httplib 0.11 listens with a backlog of 5; a few hundred workers connecting at once would
+  // overflow it (dropped handshakes, failed requests). Keep the socket and widen the backlog after
+  // bind: listen() on a listening socket only changes its backlog.
+  int listen_fd = -1;
+  http.set_socket_options([&listen_fd](int fd) {
+    httplib::default_socket_options(fd);
+    listen_fd = fd;
+  });
+  int bound = port == 0 ? http.bind_to_any_port(host) : (http.bind_to_port(host, port) ? port : -1);
+  if (bound <= 0) {
+    std::fprintf(stderr, "tessera-server: cannot listen on %s\n", o.listen.c_str());
+    return 1;
+  }
+  if (listen_fd >= 0) ::listen(listen_fd, 4096);
+  if (!o.port_file.empty()) std::ofstream(o.port_file) << bound << "\n";
+  const std::string url = "http://" + (host == "0.0.0.0" ? std::string("127.0.0.1") : host) + ":" + std::to_string(bound);
+  spdlog::info("tessera-server {} listening on {} (data in {}, {} HTTP threads)", TESSERA_VERSION, url,
+               o.coordinator.data_dir, threads);
+  std::thread listener([&http] { http.listen_after_bind(); });
+
+  // Local workers: restarted if they die, stopped with the server.
+  const std::string binary = find_worker_binary(o);
+  const int per_worker = o.local_worker_threads > 0
+                             ? o.local_worker_threads
+                             : std::max(1, int(std::thread::hardware_concurrency()) / std::max(1, o.local_workers));
+  std::vector<pid_t> children(size_t(o.local_workers), 0);
+  auto cache = [&](int i) {
+    return (fs::path(o.coordinator.data_dir) / "local-workers" / std::to_string(i)).string();
+  };
+  for (int i = 0; i < o.local_workers; ++i) children[size_t(i)] = spawn_worker(binary, url, per_worker, i, cache(i));
+
+  int exit_code = 0;
+  for (;;) {
+    timespec tick{1, 0};
+    int sig = sigtimedwait(&signals, nullptr, &tick);
+    if (sig == SIGTERM || sig == SIGINT) {
+      spdlog::info("tessera-server: signal {}, shutting down", sig);
+      break;
+    }
+    for (int i = 0; i < o.local_workers; ++i) {
+      int status = 0;
+      if (children[size_t(i)] > 0 && waitpid(children[size_t(i)], &status, WNOHANG) == children[size_t(i)]) {
+        spdlog::warn("local worker {} exited (status {}); restarting it", i, status);
+        children[size_t(i)] = spawn_worker(binary, url, per_worker, i, cache(i));
+      }
+    }
+  }
+  // Workers first (they deliver finished passes and sign off over HTTP), then HTTP.
+  for (pid_t pid : children)
+    if (pid > 0) kill(pid, SIGTERM);
+  coordinator->shutdown();  // long polls return at once; results and sign-offs are still taken
+  for (pid_t pid : children)
+    if (pid > 0) waitpid(pid, nullptr, 0);
+  http.stop();
+  listener.join();
+  return exit_code;
+}
+
+}  // namespace tessera::server

@@ -1,0 +1,192 @@
+#include "tessera/server/store.h"
+
+#include <sqlite3.h>
+
+namespace tessera::server {
+namespace {
+
+constexpr const char* kSchema = R"(
+CREATE TABLE IF NOT EXISTS scenes(hash TEXT PRIMARY KEY, bytes INTEGER NOT NULL, created REAL NOT NULL);
+CREATE TABLE IF NOT EXISTS jobs(id INTEGER PRIMARY KEY AUTOINCREMENT, name TEXT NOT NULL, plan TEXT NOT NULL,
+  priority INTEGER NOT NULL, state TEXT NOT NULL, error TEXT NOT NULL DEFAULT '', created REAL NOT NULL,
+  started REAL NOT NULL DEFAULT 0, finished REAL NOT NULL DEFAULT 0);
+CREATE TABLE IF NOT EXISTS results(job INTEGER NOT NULL, tile INTEGER NOT NULL, pass INTEGER NOT NULL,
+  worker INTEGER NOT NULL, data BLOB NOT NULL, ack_seq INTEGER NOT NULL, acked REAL NOT NULL,
+  PRIMARY KEY(job, pass, tile));
+CREATE TABLE IF NOT EXISTS leases(seq INTEGER PRIMARY KEY AUTOINCREMENT, job INTEGER NOT NULL,
+  tile INTEGER NOT NULL, pass INTEGER NOT NULL, worker INTEGER NOT NULL, issued REAL NOT NULL);
+CREATE INDEX IF NOT EXISTS leases_by_unit ON leases(job, pass, tile);
+CREATE TABLE IF NOT EXISTS workers(id INTEGER PRIMARY KEY AUTOINCREMENT, name TEXT NOT NULL, threads INTEGER NOT NULL,
+  memory INTEGER NOT NULL, version TEXT NOT NULL, isa TEXT NOT NULL, registered REAL NOT NULL,
+  last_seen REAL NOT NULL, state TEXT NOT NULL);
+)";
+
+[[noreturn]] void fail(sqlite3* db, const std::string& what) {
+  int code = db ? sqlite3_errcode(db) : SQLITE_ERROR;
+  throw StoreError(what + ": " + (db ? sqlite3_errmsg(db) : "cannot open"), code == SQLITE_FULL);
+}
+
+// A prepared statement that binds left to right and finalises itself.
+class Stmt {
+ public:
+  Stmt(sqlite3* db, const char* sql) : db_(db) {
+    if (sqlite3_prepare_v2(db, sql, -1, &stmt_, nullptr) != SQLITE_OK) fail(db, "prepare");
+  }
+  ~Stmt() { sqlite3_finalize(stmt_); }
+  Stmt& bind(int64_t v) { return check(sqlite3_bind_int64(stmt_, ++n_, v)); }
+  Stmt& bind(double v) { return check(sqlite3_bind_double(stmt_, ++n_, v)); }
+  Stmt& bind(const std::string& v) {
+    return check(sqlite3_bind_text(stmt_, ++n_, v.data(), int(v.size()), SQLITE_TRANSIENT));
+  }
+  Stmt& blob(const std::string& v) {
+    return check(sqlite3_bind_blob64(stmt_, ++n_, v.data(), v.size(), SQLITE_TRANSIENT));
+  }
+  /// True while there is a row; throws on errors (a constraint violation returns false with
+  /// constraint() set).
+  bool step() {
+    int rc = sqlite3_step(stmt_);
+    if (rc == SQLITE_ROW) return true;
+    if (rc == SQLITE_DONE) return false;
+    if (rc == SQLITE_CONSTRAINT) {
+      constraint_ = true;
+      return false;
+    }
+    fail(db_, "step");
+  }
+  bool constraint() const { return constraint_; }
+  int64_t i(int col) const { return sqlite3_column_int64(stmt_, col); }
+  double d(int col) const { return sqlite3_column_double(stmt_, col); }
+  std::string s(int col) const {
+    const void* p = sqlite3_column_blob(stmt_, col);
+    return p ? std::string(static_cast<const char*>(p), size_t(sqlite3_column_bytes(stmt_, col))) : std::string();
+  }
+
+ private:
+  Stmt& check(int rc) {
+    if (rc != SQLITE_OK) fail(db_, "bind");
+    return *this;
+  }
+  sqlite3* db_;
+  sqlite3_stmt* stmt_ = nullptr;
+  int n_ = 0;
+  bool constraint_ = false;
+};
+
+}  // namespace
+
+Store::Store(const std::string& path) {
+  if (sqlite3_open_v2(path.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX,
+                      nullptr) != SQLITE_OK) {
+    std::string msg = "cannot open the state database " + path;
+    sqlite3_close(db_);
+    db_ = nullptr;
+    throw StoreError(msg, false);
+  }
+  sqlite3_busy_timeout(db_, 5000);
+  // WAL keeps readers off the writer's back; FULL fsyncs the log at every commit, which is what
+  // makes an acknowledged result survive a crash.
+  exec("PRAGMA journal_mode=WAL");
+  exec("PRAGMA synchronous=FULL");
+  exec(kSchema);
+}
+
+Store::~Store() { sqlite3_close(db_); }
+
+void Store::exec(const char* sql) {
+  char* err = nullptr;
+  if (sqlite3_exec(db_, sql, nullptr, nullptr, &err) != SQLITE_OK) {
+    std::string msg = err ? err : "error";
+    sqlite3_free(err);
+    throw StoreError(std::string("state database: ") + msg, sqlite3_errcode(db_) == SQLITE_FULL);
+  }
+}
+
+void Store::add_scene(const std::string& hash, uint64_t bytes, double now) {
+  Stmt st(db_, "INSERT OR IGNORE INTO scenes(hash, bytes, created) VALUES(?, ?, ?)");
+  st.bind(hash).bind(int64_t(bytes)).bind(now).step();
+}
+
+bool Store::has_scene(const std::string& hash) {
+  Stmt st(db_, "SELECT 1 FROM scenes WHERE hash = ?");
+  return st.bind(hash).step();
+}
+
+uint64_t Store::add_job(const std::string& name, const std::string& plan_json, int priority, double now) {
+  Stmt st(db_, "INSERT INTO jobs(name, plan, priority, state, created) VALUES(?, ?, ?, 'queued', ?)");
+  st.bind(name).bind(plan_json).bind(int64_t(priority)).bind(now).step();
+  return uint64_t(sqlite3_last_insert_rowid(db_));
+}
+
+void Store::set_job_state(uint64_t id, const std::string& state, const std::string& error, double started,
+                          double finished) {
+  Stmt st(db_, "UPDATE jobs SET state = ?, error = ?, started = ?, finished = ? WHERE id = ?");
+  st.bind(state).bind(error).bind(started).bind(finished).bind(int64_t(id)).step();
+}
+
+std::vector<JobRow> Store::jobs() {
+  Stmt st(db_, "SELECT id, name, plan, priority, state, error, created, started, finished FROM jobs ORDER BY id");
+  std::vector<JobRow> rows;
+  while (st.step())
+    rows.push_back({uint64_t(st.i(0)), st.s(1), st.s(2), st.s(4), st.s(5), int(st.i(3)), st.d(6), st.d(7), st.d(8)});
+  return rows;
+}
+
+uint64_t Store::log_lease(uint64_t job, uint32_t tile, uint32_t pass, uint64_t worker, double now) {
+  Stmt st(db_, "INSERT INTO leases(job, tile, pass, worker, issued) VALUES(?, ?, ?, ?, ?)");
+  st.bind(int64_t(job)).bind(int64_t(tile)).bind(int64_t(pass)).bind(int64_t(worker)).bind(now).step();
+  return uint64_t(sqlite3_last_insert_rowid(db_));
+}
+
+bool Store::add_result(uint64_t job, uint32_t tile, uint32_t pass, uint64_t worker, const std::string& data,
+                       double now) {
+  // ack_seq: the newest lease at acknowledgement; any lease for this pass with a larger sequence
+  // number was issued after the pass was safe (reissued_after_ack).
+  Stmt st(db_,
+          "INSERT INTO results(job, tile, pass, worker, data, ack_seq, acked) "
+          "VALUES(?, ?, ?, ?, ?, (SELECT COALESCE(MAX(seq), 0) FROM leases), ?)");
+  st.bind(int64_t(job)).bind(int64_t(tile)).bind(int64_t(pass)).bind(int64_t(worker)).blob(data).bind(now);
+  st.step();
+  return !st.constraint();
+}
+
+void Store::for_each_result(uint64_t job, const std::function<void(ResultRow&&)>& fn) {
+  Stmt st(db_, "SELECT tile, pass, worker, data FROM results WHERE job = ? ORDER BY pass, tile");
+  st.bind(int64_t(job));
+  while (st.step()) fn(ResultRow{uint32_t(st.i(0)), uint32_t(st.i(1)), uint64_t(st.i(2)), st.s(3)});
+}
+
+uint64_t Store::reissued_after_ack(uint64_t job) {
+  Stmt st(db_,
+          "SELECT COUNT(*) FROM leases l JOIN results r ON r.job = l.job AND r.pass = l.pass AND r.tile = l.tile "
+          "WHERE l.job = ? AND l.seq > r.ack_seq");
+  st.bind(int64_t(job)).step();
+  return uint64_t(st.i(0));
+}
+
+uint64_t Store::leases_issued(uint64_t job) {
+  Stmt st(db_, "SELECT COUNT(*) FROM leases WHERE job = ?");
+  st.bind(int64_t(job)).step();
+  return uint64_t(st.i(0));
+}
+
+uint64_t Store::add_worker(const WorkerRow& w) {
+  Stmt st(db_,
+          "INSERT INTO workers(name, threads, memory, version, isa, registered, last_seen, state) "
+          "VALUES(?, ?, ?, ?, ?, ?, ?, 'idle')");
+  st.bind(w.name).bind(int64_t(w.threads)).bind(int64_t(w.memory)).bind(w.version).bind(w.isa).bind(w.registered)
+      .bind(w.registered).step();
+  return uint64_t(sqlite3_last_insert_rowid(db_));
+}
+
+std::optional<WorkerRow> Store::worker(uint64_t id) {
+  Stmt st(db_, "SELECT id, name, version, isa, threads, memory, registered FROM workers WHERE id = ?");
+  if (!st.bind(int64_t(id)).step()) return std::nullopt;
+  return WorkerRow{uint64_t(st.i(0)), st.s(1), st.s(2), st.s(3), int(st.i(4)), uint64_t(st.i(5)), st.d(6)};
+}
+
+void Store::touch_worker(uint64_t id, double now, const std::string& state) {
+  Stmt st(db_, "UPDATE workers SET last_seen = ?, state = ? WHERE id = ?");
+  st.bind(now).bind(state).bind(int64_t(id)).step();
+}
+
+}  // namespace tessera::server

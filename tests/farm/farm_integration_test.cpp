@@ -1,0 +1,178 @@
+// The farm end to end: a real coordinator and real workers (child processes) on loopback. Every
+// finished image is compared bit for bit with an in-process render of the same settings, which is
+// what `tessera render` produces.
+#include "farm_harness.h"
+
+namespace tessera::test {
+namespace {
+
+std::string cornell() { return shared_path("scenes/cornell-box/scene.xml"); }
+
+// 100 wide with tiles of 24 (not a multiple); 37 spp (not a power of two): passes 1,2,4,8,16,6.
+JobSettings small_job() {
+  JobSettings s;
+  s.name = "cornell-small";
+  s.spp = 37;
+  s.width = 100;
+  s.height = 75;
+  s.tile_size = 24;
+  s.seed = 11;
+  return s;
+}
+
+// Long enough (about 4 s on one thread) to kill things in the middle of it.
+JobSettings long_job() {
+  JobSettings s;
+  s.name = "cornell-long";
+  s.spp = 150;
+  s.width = 120;
+  s.height = 96;
+  s.tile_size = 16;
+  s.seed = 3;
+  return s;
+}
+
+double progress(const nlohmann::json& j) { return j.value("progress", 0.0); }
+
+TEST(FarmIntegration, TwoWorkersStitchTheImageBitForBit) {
+  TESSERA_REQUIRE_FILE(cornell());
+  Farm farm;
+  farm.start_server();
+  farm.add_worker();
+  farm.add_worker();
+  ASSERT_TRUE(farm.wait_workers(2));
+  const JobSettings settings = small_job();
+  farm::HttpReply reply;
+  uint64_t id = farm.submit(cornell(), settings, &reply);
+  ASSERT_GT(id, 0u) << reply.describe();
+  nlohmann::json st = farm.wait_job(id);
+  ASSERT_EQ(st.value("state", ""), "done") << st.dump(2);
+  EXPECT_EQ(st["passes"], 6);
+  EXPECT_EQ(st["tiles"], 5 * 4);
+  EXPECT_EQ(st["units_done"], st["units_total"]);
+  EXPECT_EQ(st["workers"].size(), 2u) << "both workers should have rendered part of it: " << st["workers"].dump();
+  Image farm_image = farm.image(id);
+  Image local = local_render(cornell(), settings);
+  ASSERT_EQ(farm_image.width(), 100);
+  EXPECT_EQ(differing_pixels(farm_image, local), 0);
+  std::printf("shares: %s\n", st["workers"].dump().c_str());
+}
+
+TEST(FarmIntegration, KilledWorkerLeaseIsReissuedAndTheImageIsUnchanged) {
+  TESSERA_REQUIRE_FILE(cornell());
+  Farm farm({"--lease-timeout", "1.5"});
+  farm.start_server();
+  farm.add_worker();
+  farm.add_worker();
+  ASSERT_TRUE(farm.wait_workers(2));
+  const JobSettings settings = long_job();
+  uint64_t id = farm.submit(cornell(), settings);
+  ASSERT_GT(id, 0u);
+  nlohmann::json mid = farm.wait_until(id, [](const nlohmann::json& j) { return progress(j) > 0.2; });
+  ASSERT_EQ(mid.value("state", ""), "running") << "the job ended before the worker could be killed";
+  farm.worker(0).kill_now();  // kill -9: its leases in flight are lost
+  nlohmann::json st = farm.wait_job(id);
+  ASSERT_EQ(st.value("state", ""), "done") << st.dump(2);
+  EXPECT_EQ(differing_pixels(farm.image(id), local_render(cornell(), settings)), 0);
+  std::printf("killed worker at %.0f%%; leases issued %d for %d units\n", 100 * progress(mid),
+              st.value("leases_issued", 0), st.value("units_total", 0));
+}
+
+TEST(FarmIntegration, KilledCoordinatorResumesWithoutRerenderingAcknowledgedPasses) {
+  TESSERA_REQUIRE_FILE(cornell());
+  Farm farm;
+  farm.start_server();
+  farm.add_worker();
+  farm.add_worker();
+  ASSERT_TRUE(farm.wait_workers(2));
+  const JobSettings settings = long_job();
+  uint64_t id = farm.submit(cornell(), settings);
+  ASSERT_GT(id, 0u);
+  nlohmann::json mid = farm.wait_until(id, [](const nlohmann::json& j) { return progress(j) > 0.3; });
+  ASSERT_EQ(mid.value("state", ""), "running");
+  farm.kill_server();  // kill -9, mid-job; the workers keep their leases and retry
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  farm.start_server();  // same port, same data dir
+  nlohmann::json resumed = farm.status(id);
+  ASSERT_TRUE(resumed.is_object());
+  EXPECT_GE(resumed.value("units_done", 0), mid.value("units_done", 0)) << "acknowledged passes were lost";
+  nlohmann::json st = farm.wait_job(id);
+  ASSERT_EQ(st.value("state", ""), "done") << st.dump(2);
+  EXPECT_EQ(st.value("reissued_acknowledged_passes", -1), 0);
+  EXPECT_EQ(differing_pixels(farm.image(id), local_render(cornell(), settings)), 0);
+  std::printf("coordinator killed at %d/%d units; after restart %d; leases issued %d, re-issued after ack %d\n",
+              mid.value("units_done", 0), mid.value("units_total", 0), resumed.value("units_done", 0),
+              st.value("leases_issued", 0), st.value("reissued_acknowledged_passes", -1));
+}
+
+TEST(FarmIntegration, HigherPriorityJobOvertakesAndCancelStopsAJob) {
+  TESSERA_REQUIRE_FILE(cornell());
+  Farm farm;
+  farm.start_server();
+  farm.add_worker();
+  ASSERT_TRUE(farm.wait_workers(1));
+  JobSettings low = long_job();
+  low.priority = 0;
+  uint64_t low_id = farm.submit(cornell(), low);
+  ASSERT_GT(low_id, 0u);
+  farm.wait_until(low_id, [](const nlohmann::json& j) { return j.value("units_done", 0) > 0; });
+  JobSettings high = small_job();
+  high.priority = 5;
+  uint64_t high_id = farm.submit(cornell(), high);
+  ASSERT_GT(high_id, 0u);
+  nlohmann::json high_st = farm.wait_job(high_id);
+  ASSERT_EQ(high_st.value("state", ""), "done");
+  nlohmann::json low_st = farm.status(low_id);
+  EXPECT_EQ(low_st.value("state", ""), "running") << "the high-priority job should finish first";
+
+  farm::HttpReply r = farm.client().del("/api/v1/jobs/" + std::to_string(low_id));
+  EXPECT_EQ(r.status, 200) << r.describe();
+  nlohmann::json cancelled = farm.wait_job(low_id, 10);
+  EXPECT_EQ(cancelled.value("state", ""), "cancelled");
+  // Cancelled work stops: the units done stay put, and a second cancel is refused.
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  EXPECT_EQ(farm.status(low_id).value("units_done", -1), farm.status(low_id).value("units_done", -2));
+  EXPECT_EQ(farm.client().del("/api/v1/jobs/" + std::to_string(low_id)).status, 409);
+  // The partial image is still served, and the farm takes new work.
+  EXPECT_EQ(farm.client().get("/api/v1/jobs/" + std::to_string(low_id) + "/image?format=png").status, 200);
+  uint64_t again = farm.submit(cornell(), small_job());
+  EXPECT_EQ(farm.wait_job(again).value("state", ""), "done");
+}
+
+TEST(FarmIntegration, WorkerJoiningMidJobGetsWork) {
+  TESSERA_REQUIRE_FILE(cornell());
+  Farm farm;
+  farm.start_server();
+  farm.add_worker();
+  ASSERT_TRUE(farm.wait_workers(1));
+  const JobSettings settings = long_job();
+  uint64_t id = farm.submit(cornell(), settings);
+  ASSERT_GT(id, 0u);
+  farm.wait_until(id, [](const nlohmann::json& j) { return progress(j) > 0.1; });
+  farm.add_worker();
+  nlohmann::json st = farm.wait_job(id);
+  ASSERT_EQ(st.value("state", ""), "done");
+  ASSERT_EQ(st["workers"].size(), 2u) << st["workers"].dump();
+  for (auto& w : st["workers"]) EXPECT_GT(w.value("samples", 0), 0);
+  EXPECT_EQ(differing_pixels(farm.image(id), local_render(cornell(), settings)), 0);
+}
+
+TEST(FarmIntegration, WorkerStopsCleanlyOnSigterm) {
+  TESSERA_REQUIRE_FILE(cornell());
+  Farm farm;
+  farm.start_server();
+  farm.add_worker();
+  ASSERT_TRUE(farm.wait_workers(1));
+  uint64_t id = farm.submit(cornell(), long_job());
+  farm.wait_until(id, [](const nlohmann::json& j) { return progress(j) > 0.1; });
+  EXPECT_EQ(farm.worker(0).terminate(), 0);
+  nlohmann::json workers = farm.client().get("/api/v1/workers").json();
+  ASSERT_TRUE(workers.is_object());
+  EXPECT_EQ(workers["workers"][0]["state"], "gone");
+  // What it had not finished goes to the next worker at once (no lease timeout to wait for).
+  farm.add_worker();
+  EXPECT_EQ(farm.wait_job(id).value("state", ""), "done");
+}
+
+}  // namespace
+}  // namespace tessera::test

@@ -1,0 +1,47 @@
+// A small HTTP client for the farm's API (docs/api.md), shared by tessera-worker and the
+// `tessera submit/jobs/cancel` commands. Never throws: transport failures are status 0.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <map>
+#include <string>
+
+namespace tessera::farm {
+
+struct HttpReply {
+  int status = 0;          // 0: no answer (connection refused, timeout, ...)
+  std::string body;
+  std::string transport;   // what went wrong when status == 0
+  std::map<std::string, std::string> headers;
+  bool ok() const { return status >= 200 && status < 300; }
+  /// The body as JSON (null if it is not).
+  nlohmann::json json() const;
+  /// "HTTP 422 scene_load_failed: <detail>" or the transport error: for messages.
+  std::string describe() const;
+};
+
+class FarmClient {
+ public:
+  /// `url`: http://HOST:PORT (a trailing slash is fine).
+  explicit FarmClient(std::string url);
+  const std::string& url() const { return url_; }
+  /// False with a message if the URL is not http://HOST[:PORT].
+  bool valid(std::string* why = nullptr) const;
+
+  HttpReply get(const std::string& path, double timeout_seconds = 30) const;
+  HttpReply del(const std::string& path, const nlohmann::json& body = nlohmann::json::object(),
+                double timeout_seconds = 30) const;
+  HttpReply post_json(const std::string& path, const nlohmann::json& body, double timeout_seconds = 30) const;
+  HttpReply post_bytes(const std::string& path, const std::string& bytes, const std::string& content_type,
+                       double timeout_seconds = 60) const;
+  /// multipart/form-data with a JSON field "settings" and a file field "bundle".
+  HttpReply post_job_with_bundle(const nlohmann::json& settings, const std::string& bundle,
+                                 double timeout_seconds = 600) const;
+
+ private:
+  std::string url_, host_;
+  int port_ = 0;
+};
+
+}  // namespace tessera::farm

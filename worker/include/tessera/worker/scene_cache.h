@@ -1,0 +1,57 @@
+// A worker's scenes: bundles downloaded once (verified by hash) into the cache directory, only
+// the files a job's scene references unpacked, and loaded scenes (with their BVH) kept across
+// tiles and jobs, least recently used evicted beyond a memory budget.
+#pragma once
+
+#include "tessera/farm/protocol.h"
+#include "tessera/render/scene.h"
+#include "tessera/worker/farm_client.h"
+
+#include <cstdint>
+#include <future>
+#include <list>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+
+namespace tessera::farm {
+
+struct CachedScene {
+  std::unique_ptr<Scene> scene;
+  uint64_t bytes = 0;  // estimate: meshes, BVH, images
+};
+
+class SceneCache {
+ public:
+  SceneCache(std::string cache_dir, uint64_t memory_budget);
+
+  /// The loaded scene for a lease; downloads, unpacks and loads on first use. Concurrent callers
+  /// for the same scene wait for one load. Throws std::runtime_error (download/bundle problems) or
+  /// the loader's SceneError/UnsupportedError.
+  std::shared_ptr<const CachedScene> get(const Lease& lease, const FarmClient& client);
+
+  size_t loaded_scenes() const;
+  uint64_t loaded_bytes() const;
+  /// Number of bundle downloads so far (a test checks each bundle is fetched once).
+  uint64_t downloads() const { return downloads_; }
+
+ private:
+  std::string bundle_file(const Lease& lease, const FarmClient& client);
+  std::shared_ptr<const CachedScene> load(const Lease& lease, const FarmClient& client);
+  void evict_locked();
+
+  std::string dir_;
+  uint64_t budget_;
+  mutable std::mutex mutex_;
+  std::mutex download_mutex_;
+  struct Entry {
+    std::shared_future<std::shared_ptr<const CachedScene>> scene;
+    std::list<std::string>::iterator lru;
+  };
+  std::map<std::string, Entry> entries_;
+  std::list<std::string> lru_;  // most recent first
+  std::atomic<uint64_t> downloads_{0};
+};
+
+}  // namespace tessera::farm

@@ -1,0 +1,97 @@
+#include "tessera/worker/farm_client.h"
+
+#include <httplib.h>
+
+namespace tessera::farm {
+
+using nlohmann::json;
+
+namespace {
+
+HttpReply reply_of(const httplib::Result& r) {
+  HttpReply out;
+  if (!r) {
+    out.transport = httplib::to_string(r.error());
+    return out;
+  }
+  out.status = r->status;
+  out.body = r->body;
+  for (auto& [k, v] : r->headers) out.headers[k] = v;
+  return out;
+}
+
+std::unique_ptr<httplib::Client> make_client(const std::string& host, int port, double timeout) {
+  auto c = std::make_unique<httplib::Client>(host, port);
+  const time_t sec = time_t(timeout);
+  const time_t usec = time_t((timeout - double(sec)) * 1e6);
+  c->set_connection_timeout(5, 0);
+  c->set_read_timeout(sec, usec);
+  c->set_write_timeout(sec, usec);
+  c->set_keep_alive(false);
+  return c;
+}
+
+}  // namespace
+
+nlohmann::json HttpReply::json() const {
+  nlohmann::json j = nlohmann::json::parse(body, nullptr, false);
+  return j.is_discarded() ? nlohmann::json() : j;
+}
+
+std::string HttpReply::describe() const {
+  if (status == 0) return "no answer from the server (" + transport + ")";
+  nlohmann::json j = json();
+  std::string s = "HTTP " + std::to_string(status);
+  if (j.is_object() && j.contains("error")) {
+    s += " " + j["error"].get<std::string>();
+    if (j.contains("detail") && j["detail"].is_string()) s += ": " + j["detail"].get<std::string>();
+  }
+  return s;
+}
+
+FarmClient::FarmClient(std::string url) : url_(std::move(url)) {
+  while (!url_.empty() && url_.back() == '/') url_.pop_back();
+  const std::string scheme = "http://";
+  if (url_.rfind(scheme, 0) != 0) return;
+  std::string rest = url_.substr(scheme.size());
+  size_t colon = rest.rfind(':');
+  host_ = colon == std::string::npos ? rest : rest.substr(0, colon);
+  try {
+    port_ = colon == std::string::npos ? 80 : std::stoi(rest.substr(colon + 1));
+  } catch (const std::exception&) {
+    port_ = 0;
+  }
+}
+
+bool FarmClient::valid(std::string* why) const {
+  if (!host_.empty() && port_ > 0 && port_ < 65536) return true;
+  if (why) *why = "server URL '" + url_ + "' is not http://HOST:PORT";
+  return false;
+}
+
+HttpReply FarmClient::get(const std::string& path, double timeout) const {
+  return reply_of(make_client(host_, port_, timeout)->Get(path.c_str()));
+}
+
+HttpReply FarmClient::del(const std::string& path, const json& body, double timeout) const {
+  return reply_of(make_client(host_, port_, timeout)->Delete(path.c_str(), body.dump(), "application/json"));
+}
+
+HttpReply FarmClient::post_json(const std::string& path, const json& body, double timeout) const {
+  return reply_of(make_client(host_, port_, timeout)->Post(path.c_str(), body.dump(), "application/json"));
+}
+
+HttpReply FarmClient::post_bytes(const std::string& path, const std::string& bytes, const std::string& type,
+                                 double timeout) const {
+  return reply_of(make_client(host_, port_, timeout)->Post(path.c_str(), bytes, type.c_str()));
+}
+
+HttpReply FarmClient::post_job_with_bundle(const json& settings, const std::string& bundle, double timeout) const {
+  httplib::MultipartFormDataItems items = {
+      {"settings", settings.dump(), "settings.json", "application/json"},
+      {"bundle", bundle, "scene.tar.gz", "application/gzip"},
+  };
+  return reply_of(make_client(host_, port_, timeout)->Post("/api/v1/jobs", items));
+}
+
+}  // namespace tessera::farm

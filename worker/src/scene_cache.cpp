@@ -1,0 +1,134 @@
+#include "tessera/worker/scene_cache.h"
+
+#include "tessera/farm/bundle.h"
+#include "tessera/farm/job_scene.h"
+#include "tessera/farm/sha256.h"
+
+#include <spdlog/spdlog.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <set>
+#include <sstream>
+
+namespace tessera::farm {
+
+namespace fs = std::filesystem;
+
+SceneCache::SceneCache(std::string cache_dir, uint64_t budget) : dir_(std::move(cache_dir)), budget_(budget) {
+  fs::create_directories(fs::path(dir_) / "bundles");
+  fs::create_directories(fs::path(dir_) / "scenes");
+}
+
+std::string SceneCache::bundle_file(const Lease& lease, const FarmClient& client) {
+  const std::string& hash = lease.settings.scene;
+  const fs::path path = fs::path(dir_) / "bundles" / (hash + ".bundle");
+  std::lock_guard<std::mutex> lock(download_mutex_);
+  if (fs::exists(path)) return path.string();
+  HttpReply r = client.get("/api/v1/scenes/" + hash, 600);
+  if (!r.ok()) throw std::runtime_error("cannot download scene bundle " + hash + ": " + r.describe());
+  if (sha256_hex(r.body) != hash) throw std::runtime_error("scene bundle " + hash + " arrived corrupt (hash mismatch)");
+  const fs::path tmp = path.string() + ".tmp" + std::to_string(std::random_device{}());
+  std::ofstream(tmp, std::ios::binary).write(r.body.data(), std::streamsize(r.body.size()));
+  fs::rename(tmp, path);
+  ++downloads_;
+  spdlog::info("downloaded scene bundle {} ({} bytes)", hash.substr(0, 12), r.body.size());
+  return path.string();
+}
+
+std::shared_ptr<const CachedScene> SceneCache::load(const Lease& lease, const FarmClient& client) {
+  const std::string bundle = bundle_file(lease, client);
+  // Only what the scene references is unpacked; the directory is keyed by that list, so two jobs
+  // that use different parts of one bundle do not disturb each other.
+  std::string files_key;
+  for (const auto& f : lease.files) files_key += f + "\n";
+  const fs::path dir = fs::path(dir_) / "scenes" / (lease.settings.scene.substr(0, 32) + "-" + sha256_hex(files_key).substr(0, 16));
+  {
+    std::lock_guard<std::mutex> lock(download_mutex_);
+    if (!fs::exists(dir)) {
+      std::ifstream in(bundle, std::ios::binary);
+      std::ostringstream ss;
+      ss << in.rdbuf();
+      BundleResult r = unpack_bundle(ss.str(), dir.string(), BundleLimits{},
+                                     std::set<std::string>(lease.files.begin(), lease.files.end()));
+      if (!r.ok()) throw std::runtime_error("scene bundle " + lease.settings.scene.substr(0, 12) + ": " + r.error);
+    }
+  }
+  LoadedJobScene loaded = load_job_scene(dir.string(), lease.scene_file, lease.settings);
+  auto out = std::make_shared<CachedScene>();
+  out->scene = std::move(loaded.loaded.scene);
+  out->bytes = uint64_t(out->scene->accel().stats().bytes) + uint64_t(out->scene->num_triangles()) * 64 + (1u << 20);
+  return out;
+}
+
+std::shared_ptr<const CachedScene> SceneCache::get(const Lease& lease, const FarmClient& client) {
+  const std::string key = scene_cache_key(lease.settings, lease.scene_file);
+  std::promise<std::shared_ptr<const CachedScene>> promise;
+  std::shared_future<std::shared_ptr<const CachedScene>> future;
+  bool loader = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = entries_.find(key);
+    if (it != entries_.end()) {
+      lru_.splice(lru_.begin(), lru_, it->second.lru);
+      future = it->second.scene;
+    } else {
+      future = promise.get_future().share();
+      lru_.push_front(key);
+      entries_[key] = Entry{future, lru_.begin()};
+      loader = true;
+    }
+  }
+  if (loader) {
+    try {
+      promise.set_value(load(lease, client));
+    } catch (...) {
+      // A failed load is not cached: the next lease tries again (the bundle may have been fixed).
+      promise.set_exception(std::current_exception());
+      std::lock_guard<std::mutex> lock(mutex_);
+      auto it = entries_.find(key);
+      if (it != entries_.end()) {
+        lru_.erase(it->second.lru);
+        entries_.erase(it);
+      }
+      throw;
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    evict_locked();
+  }
+  return future.get();
+}
+
+void SceneCache::evict_locked() {
+  // Oldest first; a scene in use (another reference alive) or still loading stays.
+  uint64_t total = 0;
+  for (auto& [k, e] : entries_)
+    if (e.scene.wait_for(std::chrono::seconds(0)) == std::future_status::ready) total += e.scene.get()->bytes;
+  for (auto it = lru_.end(); it != lru_.begin() && total > budget_ && entries_.size() > 1;) {
+    --it;
+    auto e = entries_.find(*it);
+    if (e->second.scene.wait_for(std::chrono::seconds(0)) != std::future_status::ready) continue;
+    const auto& scene = e->second.scene.get();
+    if (scene.use_count() > 1) continue;  // a slot is rendering with it
+    total -= scene->bytes;
+    spdlog::info("evicting scene {} ({} MB) from the cache", it->substr(0, 12), scene->bytes >> 20);
+    entries_.erase(e);
+    it = lru_.erase(it);
+  }
+}
+
+size_t SceneCache::loaded_scenes() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return entries_.size();
+}
+
+uint64_t SceneCache::loaded_bytes() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  uint64_t total = 0;
+  for (auto& [k, e] : entries_)
+    if (e.scene.wait_for(std::chrono::seconds(0)) == std::future_status::ready) total += e.scene.get()->bytes;
+  return total;
+}
+
+}  // namespace tessera::farm

@@ -1,0 +1,61 @@
+#include "tessera/worker/worker_app.h"
+
+#include "tessera/worker/worker.h"
+
+#include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
+
+#include <signal.h>
+
+#include <thread>
+
+namespace tessera::farm {
+
+int worker_main(int argc, char** argv) {
+  CLI::App app{"tessera-worker: renders tiles for a Tessera coordinator"};
+  WorkerOptions o;
+  double budget_mb = 0;
+  app.add_option("--server", o.server, "coordinator URL, http://HOST:PORT")->required();
+  app.add_option("--threads", o.threads, "render threads (default: every core)")->check(CLI::Range(0, 4096));
+  app.add_option("--cache-dir", o.cache_dir, "where scene bundles are kept (default: ~/.cache/tessera-worker)");
+  app.add_option("--name", o.name, "name shown by the coordinator (default: host name)");
+  app.add_option("--memory-budget", budget_mb, "MB of loaded scenes kept in memory (default: half the RAM)");
+  app.add_option("--poll-wait", o.poll_wait, "seconds per lease long poll")->check(CLI::Range(0.0, 30.0))->capture_default_str();
+  app.add_option("--max-leases", o.max_leases, "exit after this many leases (benchmarks)");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  o.memory_budget = uint64_t(budget_mb * 1048576.0);
+
+  // SIGTERM/SIGINT: finish what is being rendered, hand back the rest, sign off. A second signal
+  // exits at once.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  ::signal(SIGPIPE, SIG_IGN);
+
+  Worker worker(o);
+  std::atomic<bool> done{false};
+  std::thread signal_thread([&] {
+    int count = 0;
+    while (!done) {
+      timespec tick{0, 200 * 1000 * 1000};
+      int sig = sigtimedwait(&signals, nullptr, &tick);
+      if (sig == SIGTERM || sig == SIGINT) {
+        if (++count > 1) std::_Exit(130);
+        spdlog::info("signal {}: finishing current passes, then signing off", sig);
+        worker.request_stop();
+      }
+    }
+  });
+  int code = worker.run();
+  done = true;
+  signal_thread.join();
+  return code;
+}
+
+}  // namespace tessera::farm
