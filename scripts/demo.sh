@@ -1,12 +1,27 @@
 #!/usr/bin/env bash
-# Sets up Tessera and renders the demo scene. Usage: scripts/demo.sh [OUT.png]
+# Sets up Tessera and renders the demo scene through the render farm: a coordinator with local
+# workers on this machine, `tessera submit --wait`, the image downloaded to OUT (+ .exr).
+# Usage: scripts/demo.sh [OUT.png] [LOCAL_WORKERS]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-out/demo.png}
+workers=${2:-2}
 
 bash scripts/install-deps.sh
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
-cmake --build build -j"$(nproc 2>/dev/null || echo 2)" --target tessera
+cmake --build build -j"$(nproc 2>/dev/null || echo 2)" --target tessera tessera-server tessera-worker
 mkdir -p "$(dirname "$out")"
-./build/cli/tessera render scenes/demo/scene.xml -o "$out" -o "${out%.*}.exr"
-echo "demo: wrote $out and ${out%.*}.exr"
+
+# A fresh coordinator on a free loopback port, its state in a scratch data directory.
+data=$(mktemp -d "${TMPDIR:-/tmp}/tessera-demo.XXXXXX")
+./build/server/tessera-server --listen 127.0.0.1:0 --port-file "$data/port" --data-dir "$data/state" \
+    --local-workers "$workers" > "$data/server.log" 2>&1 &
+server=$!
+trap 'kill -TERM $server 2>/dev/null; wait $server 2>/dev/null; rm -rf "$data"' EXIT
+for _ in $(seq 100); do [ -s "$data/port" ] && break; sleep 0.1; done
+[ -s "$data/port" ] || { cat "$data/server.log"; echo "demo: the coordinator did not start" >&2; exit 1; }
+url="http://127.0.0.1:$(cat "$data/port")"
+echo "demo: coordinator at $url with $workers local workers"
+
+./build/cli/tessera submit scenes/demo/scene.xml --server "$url" --wait -o "$out" -o "${out%.*}.exr"
+echo "demo: wrote $out and ${out%.*}.exr (rendered by the farm)"

@@ -9,6 +9,7 @@ packages=(
   nlohmann-json3-dev libtinyobjloader-dev libpugixml-dev libstb-dev libspdlog-dev libfmt-dev
   libtbb-dev libcli11-dev libopenexr-dev libimath-dev zlib1g-dev
   libcpp-httplib-dev libsqlite3-dev libssl-dev libzstd-dev libarchive-dev
+  curl bc
 )
 
 missing=()

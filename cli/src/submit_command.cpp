@@ -102,7 +102,7 @@ int run_submit(const SubmitOptions& o) {
   std::string bundle;
   try {
     const fs::path scene = fs::absolute(o.scene);
-    LoadedJobScene loaded = load_job_scene(scene.parent_path().string(), scene.filename().string(), settings);
+    LoadedJobScene loaded = load_job_scene(scene.parent_path().string(), scene.filename().string(), settings, /*confine=*/false);
     BundlePlan plan = plan_bundle(scene.string(), scene_files(loaded.desc, loaded.loaded));
     settings.scene_file = plan.files.front();
     bundle = pack_bundle(plan.root_dir, plan.files);

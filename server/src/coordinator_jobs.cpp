@@ -194,6 +194,7 @@ json Coordinator::Impl::status_json(const JobState& job) {
             {"created", job.created()},
             {"workers", workers_json},
             {"duplicate_results", job.duplicates},
+            {"result_bytes", job.result_bytes},
             {"nonfinite_samples", job.counters().nonfinite}};
   try {
     j["leases_issued"] = store.leases_issued(job.id());

@@ -213,6 +213,7 @@ Result<json> Coordinator::upload_result(uint64_t worker, uint64_t lease, std::st
   }
   const uint64_t samples = job.unit_samples(unit);
   (void)job.add_result(unit, std::move(result.film), worker);
+  job.result_bytes += bytes.size();
   w->units_done += 1;
   w->samples_done += samples;
   w->render_seconds += result.seconds;

@@ -67,6 +67,7 @@ class JobState {
   std::map<uint64_t, int> failures_by_worker;
   std::string last_failure;
   uint64_t duplicates = 0;
+  uint64_t result_bytes = 0;  // compressed bytes of the accepted results (the network cost)
 
  private:
   uint64_t id_;

@@ -139,7 +139,7 @@ TEST_F(FarmApi, WorkerProtocolRefusesBadBuildsAndBadResults) {
 
   // Render the unit for real, then break it in every way.
   auto abs = std::filesystem::absolute(cornell());
-  LoadedJobScene scene = load_job_scene(abs.parent_path().string(), abs.filename().string(), lease.settings);
+  LoadedJobScene scene = load_job_scene(abs.parent_path().string(), abs.filename().string(), lease.settings, /*confine=*/false);
   TileResult result;
   result.job_id = lease.job_id;
   result.tile = lease.tile;

@@ -134,7 +134,7 @@ class Farm {
   /// Submits `scene` (bundled as `tessera submit` does) with `settings`; returns the job id (0 on error).
   uint64_t submit(const std::string& scene, JobSettings settings, farm::HttpReply* reply = nullptr) const {
     auto abs = std::filesystem::absolute(scene);
-    LoadedJobScene loaded = load_job_scene(abs.parent_path().string(), abs.filename().string(), settings);
+    LoadedJobScene loaded = load_job_scene(abs.parent_path().string(), abs.filename().string(), settings, /*confine=*/false);
     BundlePlan plan = plan_bundle(abs.string(), scene_files(loaded.desc, loaded.loaded));
     settings.scene_file = plan.files.front();
     nlohmann::json body = to_json(settings);
@@ -180,7 +180,7 @@ class Farm {
 /// `tessera render`'s image for the same scene and settings, rendered in this process.
 inline Image local_render(const std::string& scene, const JobSettings& settings) {
   auto abs = std::filesystem::absolute(scene);
-  LoadedJobScene loaded = load_job_scene(abs.parent_path().string(), abs.filename().string(), settings);
+  LoadedJobScene loaded = load_job_scene(abs.parent_path().string(), abs.filename().string(), settings, /*confine=*/false);
   RenderSettings rs;
   rs.spp = loaded.loaded.scene->sampler.sample_count;
   rs.seed = settings.seed;

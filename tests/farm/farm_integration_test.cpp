@@ -3,6 +3,8 @@
 // what `tessera render` produces.
 #include "farm_harness.h"
 
+#include <iterator>
+
 namespace tessera::test {
 namespace {
 
@@ -172,6 +174,40 @@ TEST(FarmIntegration, WorkerStopsCleanlyOnSigterm) {
   // What it had not finished goes to the next worker at once (no lease timeout to wait for).
   farm.add_worker();
   EXPECT_EQ(farm.wait_job(id).value("state", ""), "done");
+}
+
+// The client as users run it: `tessera submit ... -o`, `tessera jobs`, `tessera cancel`.
+TEST(FarmIntegration, SubmitCommandDownloadsTheSameImage) {
+  TESSERA_REQUIRE_FILE(cornell());
+  Farm farm;
+  farm.start_server();
+  farm.add_worker(2);
+  ASSERT_TRUE(farm.wait_workers(1));
+  const std::string out = (farm.dir().path / "sub" / "cornell.exr").string();
+  const std::string png = (farm.dir().path / "cornell.png").string();
+  const std::string log = farm.log("submit");
+  const std::string cli = std::string(TESSERA_CLI_BIN) + " ";
+  std::string cmd = cli + "submit " + cornell() + " --server " + farm.url() +
+                    " --spp 37 --width 100 --height 75 --tile-size 24 --seed 11 --name from-cli -q -o " + out + " -o " +
+                    png + " > " + log + " 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  EXPECT_EQ(differing_pixels(read_exr(out), local_render(cornell(), small_job())), 0);
+  EXPECT_TRUE(std::filesystem::file_size(png) > 100);
+
+  const std::string jobs = farm.log("jobs");
+  ASSERT_EQ(std::system((cli + "jobs --server " + farm.url() + " > " + jobs + " 2>&1").c_str()), 0);
+  std::ifstream in(jobs);
+  std::string listing((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(listing.find("from-cli"), std::string::npos) << listing;
+  EXPECT_NE(listing.find("done"), std::string::npos) << listing;
+  // Cancelling a finished job or an unknown one fails with the server's reason.
+  EXPECT_NE(std::system((cli + "cancel 1 --server " + farm.url() + " > " + jobs + " 2>&1").c_str()), 0);
+  EXPECT_NE(std::system((cli + "cancel 99 --server " + farm.url() + " > " + jobs + " 2>&1").c_str()), 0);
+  // A scene that does not load fails before anything is sent.
+  TempDir bad;
+  std::string xml = bad.write("bad.xml", "<scene version=\"0.6.0\"><shape type=\"obj\"/></scene>");
+  EXPECT_NE(std::system((cli + "submit " + xml + " --server " + farm.url() + " > " + jobs + " 2>&1").c_str()), 0);
+  EXPECT_EQ(farm.client().get("/api/v1/jobs").json()["jobs"].size(), 1u);
 }
 
 }  // namespace

@@ -105,16 +105,19 @@ void SceneCache::evict_locked() {
   uint64_t total = 0;
   for (auto& [k, e] : entries_)
     if (e.scene.wait_for(std::chrono::seconds(0)) == std::future_status::ready) total += e.scene.get()->bytes;
-  for (auto it = lru_.end(); it != lru_.begin() && total > budget_ && entries_.size() > 1;) {
-    --it;
+  // The most recent entry (the scene just loaded) is never evicted: the caller is about to use it.
+  for (auto it = std::prev(lru_.end()); it != lru_.begin() && total > budget_;) {
     auto e = entries_.find(*it);
-    if (e->second.scene.wait_for(std::chrono::seconds(0)) != std::future_status::ready) continue;
+    if (e->second.scene.wait_for(std::chrono::seconds(0)) != std::future_status::ready ||
+        e->second.scene.get().use_count() > 1) {  // loading, or a slot is rendering with it
+      --it;
+      continue;
+    }
     const auto& scene = e->second.scene.get();
-    if (scene.use_count() > 1) continue;  // a slot is rendering with it
     total -= scene->bytes;
     spdlog::info("evicting scene {} ({} MB) from the cache", it->substr(0, 12), scene->bytes >> 20);
     entries_.erase(e);
-    it = lru_.erase(it);
+    it = std::prev(lru_.erase(it));
   }
 }
 

@@ -12,9 +12,10 @@ namespace tessera {
 namespace fs = std::filesystem;
 
 LoadedJobScene load_job_scene(const std::string& bundle_dir, const std::string& scene_file,
-                              const JobSettings& settings) {
+                              const JobSettings& settings, bool confine) {
   ParseOptions parse_options;
   parse_options.defines = settings.defines;
+  if (confine) parse_options.root_dir = bundle_dir;
   LoadedJobScene out;
   out.desc = parse_scene_file((fs::path(bundle_dir) / scene_file).string(), parse_options);
   LoadOptions load_options;
@@ -22,6 +23,7 @@ LoadedJobScene load_job_scene(const std::string& bundle_dir, const std::string& 
   load_options.height = settings.height;
   load_options.spp = settings.spp;
   load_options.integrator = settings.integrator;
+  if (confine) load_options.root_dir = bundle_dir;
   out.loaded = load_scene(out.desc, load_options);
   if (!settings.light_selection.empty()) {
     LightSelection selection;

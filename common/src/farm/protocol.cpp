@@ -29,9 +29,14 @@ class Fields {
     try {
       if constexpr (std::is_integral_v<T>) {
         if (!it->is_number_integer()) throw std::invalid_argument("an integer");
-        int64_t v = it->template get<int64_t>();
-        if (v < int64_t(std::numeric_limits<T>::min()) || uint64_t(v) > uint64_t(std::numeric_limits<T>::max()))
-          throw std::invalid_argument("an integer in range");
+        const bool in_range =
+            it->is_number_unsigned()
+                ? it->template get<uint64_t>() <= uint64_t(std::numeric_limits<T>::max())
+                : it->template get<int64_t>() >= int64_t(std::numeric_limits<T>::min()) &&
+                      (it->template get<int64_t>() < 0 ||
+                       uint64_t(it->template get<int64_t>()) <= uint64_t(std::numeric_limits<T>::max()));
+        if (!in_range) throw std::invalid_argument("an integer in range");
+        const int64_t v = it->is_number_unsigned() ? int64_t(it->template get<uint64_t>()) : it->template get<int64_t>();
         out = T(v);
       } else if constexpr (std::is_floating_point_v<T>) {
         if (!it->is_number()) throw std::invalid_argument("a number");

@@ -5,6 +5,7 @@
 #include "tessera/core/check.h"
 
 #include "scene/builder_internal.h"
+#include "scene/path_confinement.h"
 
 #include <algorithm>
 #include <filesystem>
@@ -35,13 +36,24 @@ std::string LoadContext::resolve_path(const std::string& name, const FileLoc& lo
     candidates.push_back(fs::path(desc_.base_dir) / p);
     if (!loc.file.empty()) candidates.push_back(fs::path(loc.file).parent_path() / p);
   }
+  // Confined (a bundle): a candidate outside the root is not even looked up, so that the error
+  // does not tell whether a file outside exists; one inside that turns out to be a symlink out is
+  // refused rather than skipped.
+  const std::string& root = root_dir();
+  bool skipped_outside = false;
   std::error_code ec;
   for (const fs::path& c : candidates) {
+    if (!detail::lexically_inside(root, c)) {
+      skipped_outside = true;
+      continue;
+    }
     if (!fs::is_regular_file(c, ec)) continue;
+    if (!detail::canonically_inside(root, c)) detail::throw_outside_root(loc, name);
     if (!std::ifstream(c, std::ios::binary)) throw SceneError(loc, "cannot read '" + c.string() + "'");
     if (resolved_set_.insert(c.string()).second) resolved_files_.push_back(c.string());
     return c.string();
   }
+  if (skipped_outside) detail::throw_outside_root(loc, name);
   throw SceneError(loc, "file not found: '" + name + "' (looked in '" +
                             (desc_.base_dir.empty() ? std::string(".") : desc_.base_dir) + "')");
 }

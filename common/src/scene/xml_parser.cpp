@@ -3,6 +3,7 @@
 // <include>d files spliced in place. Value grammar lives in xml_values.cpp.
 #include "tessera/scene/scene_desc.h"
 
+#include "scene/path_confinement.h"
 #include "scene/xml_values.h"
 
 #include <pugixml.hpp>
@@ -79,7 +80,7 @@ std::pair<std::string, int> parse_version(const std::string& v, const FileLoc& l
 
 class Parser {
  public:
-  explicit Parser(const ParseOptions& options) : params_(options.defines) {}
+  explicit Parser(const ParseOptions& options) : params_(options.defines), root_dir_(options.root_dir) {}
 
   SceneDesc run(std::string text, const std::string& path) {
     Source src;
@@ -102,6 +103,7 @@ class Parser {
     parse_children(src, root, *desc.root, 1);
     desc.included_files = std::move(included_files_);
     desc.spectrum_files = std::move(spectrum_files_);
+    desc.root_dir = root_dir_;
     return desc;
   }
 
@@ -110,6 +112,7 @@ class Parser {
   std::map<std::string, std::shared_ptr<SceneNode>> ids_;
   std::vector<std::string> include_stack_;     // canonical paths, for cycle detection
   std::string base_dir_;
+  std::string root_dir_;                       // ParseOptions::root_dir; empty: unconfined
   std::vector<std::string> included_files_;    // as opened, for SceneDesc
   std::vector<std::string> spectrum_files_;
 
@@ -283,7 +286,7 @@ class Parser {
     } else if (tag == "animation") {
       attrs.check_allowed({"name"}, tag, loc);
       parse_animation(src, el, prop);
-    } else if (!xml::parse_value_property(tag, attrs, loc, base_dir_, prop)) {
+    } else if (!xml::parse_value_property(tag, attrs, loc, base_dir_, root_dir_, prop)) {
       throw SceneError(loc, "unknown element <" + tag + ">");
     } else if (const std::string* file = attrs.get("filename"); file && tag == "spectrum") {
       // Resolved as xml::read_spectrum_file just did: against the scene's directory.
@@ -411,11 +414,20 @@ class Parser {
       candidates.emplace_back(fs::path(src.dir) / name, (fs::path(src.dir) / name).lexically_normal());
       candidates.emplace_back(fs::path(base_dir_) / name, (fs::path(base_dir_) / name).lexically_normal());
     }
+    // Confined, as LoadContext::resolve_path: candidates outside are not looked up.
     std::error_code ec;
     const std::pair<fs::path, fs::path>* found = nullptr;
-    for (const auto& c : candidates)
-      if (!found && fs::is_regular_file(c.first, ec)) found = &c;
+    bool skipped_outside = false;
+    for (const auto& c : candidates) {
+      if (found) break;
+      if (!detail::lexically_inside(root_dir_, c.first))
+        skipped_outside = true;
+      else if (fs::is_regular_file(c.first, ec))
+        found = &c;
+    }
+    if (!found && skipped_outside) detail::throw_outside_root(loc, filename);
     if (!found) throw SceneError(loc, "cannot find included file " + squote(filename));
+    if (!detail::canonically_inside(root_dir_, found->first)) detail::throw_outside_root(loc, filename);
     std::string canonical = fs::weakly_canonical(found->first, ec).string();
     if (std::find(include_stack_.begin(), include_stack_.end(), canonical) != include_stack_.end())
       throw SceneError(loc, "<include> cycle: " + squote(filename) + " is already being read");
@@ -446,6 +458,7 @@ SceneDesc parse_scene_string(const std::string& xml_text, const std::string& vir
 }
 
 SceneDesc parse_scene_file(const std::string& path, const ParseOptions& options) {
+  if (!detail::inside_root(options.root_dir, path)) detail::throw_outside_root(FileLoc{path, 0}, path);
   std::ifstream in(path, std::ios::binary);
   if (!in || fs::is_directory(path)) throw SceneError(FileLoc{path, 0}, "cannot open scene file");
   std::ostringstream ss;

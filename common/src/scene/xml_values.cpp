@@ -1,6 +1,8 @@
 // Value grammar of Mitsuba XML attributes: strict numbers, lists, names, typed property elements.
 #include "scene/xml_values.h"
 
+#include "scene/path_confinement.h"
+
 #include <cctype>
 #include <cfloat>
 #include <charconv>
@@ -192,11 +194,12 @@ Rgb parse_spectrum_pairs(const std::vector<std::string_view>& tokens, const File
   return spectrum_to_rgb(wl, val);
 }
 
-Rgb read_spectrum_file(const std::string& filename, const std::string& base_dir, const FileLoc& loc,
-                       std::string_view what) {
+Rgb read_spectrum_file(const std::string& filename, const std::string& base_dir, const std::string& root_dir,
+                       const FileLoc& loc, std::string_view what) {
   namespace fs = std::filesystem;
   fs::path p(filename);
   if (p.is_relative() && !base_dir.empty()) p = fs::path(base_dir) / p;
+  if (!detail::inside_root(root_dir, p)) detail::throw_outside_root(loc, filename);
   std::ifstream in(p);
   if (!in) throw SceneError(loc, "cannot open spectrum file " + squote(filename));
   std::vector<double> wl, val;
@@ -238,7 +241,7 @@ Vec3 parse_xyz(const Attrs& attrs, const FileLoc& loc, std::string_view element,
 }  // namespace
 
 bool parse_value_property(std::string_view tag, const Attrs& attrs, const FileLoc& loc,
-                          const std::string& base_dir, Property& prop) {
+                          const std::string& base_dir, const std::string& root_dir, Property& prop) {
   const std::string what = elem(tag) + " '" + prop.written_name + "'";
   if (tag == "boolean" || tag == "integer" || tag == "float" || tag == "string") {
     attrs.check_allowed({"name", "value"}, tag, loc);
@@ -272,7 +275,7 @@ bool parse_value_property(std::string_view tag, const Attrs& attrs, const FileLo
     if ((value != nullptr) == (filename != nullptr))
       throw SceneError(loc, what + " needs exactly one of 'value' and 'filename'");
     if (filename) {
-      prop.color = read_spectrum_file(*filename, base_dir, loc, what);
+      prop.color = read_spectrum_file(*filename, base_dir, root_dir, loc, what);
       return true;
     }
     auto tokens = tokenize(*value);

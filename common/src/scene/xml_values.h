@@ -48,10 +48,11 @@ std::string normalize_name(std::string_view written, int version_major, std::str
                            std::string_view parent_type);
 
 /// Fills the typed part of `prop` for the property element `tag` (boolean, integer, float, string,
-/// rgb, srgb, spectrum, blackbody, point, vector). `base_dir` resolves <spectrum filename=..>.
+/// rgb, srgb, spectrum, blackbody, point, vector). `base_dir` resolves <spectrum filename=..>, which
+/// must lie inside `root_dir` unless that is empty (ParseOptions::root_dir).
 /// Returns false when `tag` is not one of these.
 bool parse_value_property(std::string_view tag, const Attrs& attrs, const FileLoc& loc,
-                          const std::string& base_dir, Property& prop);
+                          const std::string& base_dir, const std::string& root_dir, Property& prop);
 
 /// One child of <transform> (translate, rotate, scale, matrix, lookat) as a matrix. Throws
 /// SceneError for anything else or for malformed values.

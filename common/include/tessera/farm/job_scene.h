@@ -29,9 +29,11 @@ struct LoadedJobScene {
 
 /// Parses and loads `bundle_dir/scene_file` with the job's defines, size, spp, integrator and light
 /// selection. Throws SceneError / UnsupportedError as load_scene does (messages name the file and
-/// line inside the bundle).
+/// line inside the bundle). With `confine` (bundles from the network: coordinator, worker) every
+/// file the scene opens must lie inside bundle_dir; the client loading a user's own scene folder
+/// before bundling it passes false, since its references may reach above that folder.
 LoadedJobScene load_job_scene(const std::string& bundle_dir, const std::string& scene_file,
-                              const JobSettings& settings);
+                              const JobSettings& settings, bool confine = true);
 
 /// The plan for a loaded scene (`files` made relative to bundle_dir).
 JobPlan make_job_plan(const std::string& bundle_dir, const std::string& scene_file, const JobSettings& settings,

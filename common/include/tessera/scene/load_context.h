@@ -29,6 +29,10 @@ struct LoadOptions {
   int width = 0, height = 0;     // >0 overrides the film size
   int spp = 0;                   // >0 overrides the sampler's sample count
   std::string integrator;        // non-empty overrides the scene's integrator type
+  /// Confinement of the files plugins open (meshes, images) to one directory, as
+  /// ParseOptions::root_dir for the parser. Empty: SceneDesc::root_dir applies (so a description
+  /// parsed confined also loads confined); both empty: unconfined.
+  std::string root_dir;
 };
 
 struct LoadMessage {
@@ -46,8 +50,14 @@ class LoadContext {
   Scene& scene() { return scene_; }
 
   /// Resolves a file name relative to the scene's directory; throws SceneError at `loc` if the
-  /// file does not exist or cannot be read.
+  /// file does not exist or cannot be read, or lies outside root_dir() ("file 'X' is outside the
+  /// scene bundle"; candidates outside are never looked at on disk).
   std::string resolve_path(const std::string& name, const FileLoc& loc) const;
+  /// The directory files must stay inside: LoadOptions::root_dir, else SceneDesc::root_dir; empty
+  /// when unconfined.
+  const std::string& root_dir() const {
+    return options_.root_dir.empty() ? desc_.root_dir : options_.root_dir;
+  }
 
   /// A colour parameter that may be a constant (<rgb>, <spectrum>, <float>) or a nested/referenced
   /// texture. Missing -> constant `def`. Textures are created once per node and shared.

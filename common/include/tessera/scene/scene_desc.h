@@ -96,10 +96,18 @@ struct SceneDesc {
   /// each <include>d XML, and each <spectrum filename=..> data file.
   std::vector<std::string> included_files;
   std::vector<std::string> spectrum_files;
+  /// ParseOptions::root_dir as parsed: load_scene confines the files it opens to it too, unless
+  /// LoadOptions::root_dir names another root. Empty: unconfined.
+  std::string root_dir;
 };
 
 struct ParseOptions {
   std::map<std::string, std::string> defines;  // -D name=value, override <default>
+  /// Confinement (farm bundles): when non-empty, every file the parser opens (the scene file,
+  /// <include>s, <spectrum filename=..>) must lie inside this directory, both lexically and with
+  /// symlinks resolved; any other is refused with SceneError "file 'X' is outside the scene
+  /// bundle" at the element naming it, before it is opened. Empty: unconfined (`../textures` works).
+  std::string root_dir;
 };
 
 /// Reads a Mitsuba XML scene (includes followed). Throws SceneError with file and line.

@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# The farm's cost against a local render: wall time of the Cornell box through a coordinator with
+# 1 and 2 local workers vs `tessera render` on the same cores, the coordinator's CPU time per work
+# unit, and the bytes a unit's result takes on the wire. Checks the images are bit-identical.
+# Usage: bench/farm_overhead.sh [BUILD_DIR] [SPP] [SIZE] [TILE]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build=${1:-build}
+spp=${2:-256}
+size=${3:-256}
+tile=${4:-32}
+scene=../shared/scenes/cornell-box/scene.xml
+cores=$(nproc)
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+now() { date +%s.%N; }
+
+t0=$(now)
+"$build/cli/tessera" render "$scene" --spp "$spp" --width "$size" --height "$size" --tile-size "$tile" -q \
+    -o "$tmp/local.exr" 2> /dev/null
+local_s=$(echo "$(now) - $t0" | bc -l)
+printf "cornell %dx%d %d spp, %d cores, tile %d\n" "$size" "$size" "$spp" "$cores" "$tile"
+printf "%-28s %8.2f s\n" "tessera render ($cores threads)" "$local_s"
+
+for workers in 1 2; do
+  threads=$(( cores / workers > 0 ? cores / workers : 1 ))
+  data="$tmp/farm$workers"
+  mkdir -p "$data"
+  "$build/server/tessera-server" --listen 127.0.0.1:0 --port-file "$data/port" --data-dir "$data/state" \
+      --local-workers "$workers" --local-worker-threads "$threads" > "$data/server.log" 2>&1 &
+  server=$!
+  for _ in $(seq 100); do [ -s "$data/port" ] && break; sleep 0.1; done
+  url="http://127.0.0.1:$(cat "$data/port")"
+  until curl -sf "$url/api/v1/workers" | grep -c '"idle"' | grep -q "$workers"; do sleep 0.1; done
+  read -r u0 s0 < <(awk '{print $14, $15}' "/proc/$server/stat")
+  t0=$(now)
+  "$build/cli/tessera" submit "$scene" --server "$url" --spp "$spp" --width "$size" --height "$size" \
+      --tile-size "$tile" -q -o "$data/farm.exr" 2> /dev/null > /dev/null
+  wall=$(echo "$(now) - $t0" | bc -l)
+  read -r u1 s1 < <(awk '{print $14, $15}' "/proc/$server/stat")
+  status=$(curl -sf "$url/api/v1/jobs/1")
+  kill -TERM "$server"; wait "$server" || true
+  units=$(echo "$status" | python3 -c 'import json,sys; print(json.load(sys.stdin)["units_total"])')
+  bytes=$(echo "$status" | python3 -c 'import json,sys; print(json.load(sys.stdin)["result_bytes"])')
+  cpu=$(echo "($u1 + $s1 - $u0 - $s0) / $(getconf CLK_TCK)" | bc -l)
+  same=$("$build/cli/tessera" compare "$data/farm.exr" "$tmp/local.exr" | grep -o 'rel_mse=[^ ]*')
+  printf "%-28s %8.2f s  (%.2fx local)  %d units, coordinator CPU %.2f ms/unit, %.0f bytes/unit, %s\n" \
+      "farm, $workers local worker(s) x $threads" "$wall" "$(echo "$wall / $local_s" | bc -l)" "$units" \
+      "$(echo "1000 * $cpu / $units" | bc -l)" "$(echo "$bytes / $units" | bc -l)" "$same"
+done

@@ -1,0 +1,136 @@
+// The coordinator's services in-process (no HTTP): exclusion of failing workers, job failure with
+// the reason, and state that survives a restart.
+#include "tessera/farm/build_fingerprint.h"
+#include "tessera/farm/bundle.h"
+#include "tessera/farm/tile_result.h"
+#include "tessera/render/renderer.h"
+#include "tessera/scene/load_context.h"
+#include "tessera/scene/scene_desc.h"
+#include "tessera/server/coordinator.h"
+#include "test_support.h"
+
+namespace tessera::test {
+namespace {
+
+using nlohmann::json;
+using server::Coordinator;
+using server::CoordinatorOptions;
+
+constexpr const char* kXml = R"(<scene version="0.6.0">
+  <sensor type="perspective"><float name="fov" value="45"/>
+    <sampler type="independent"><integer name="sampleCount" value="5"/></sampler>
+    <film type="hdrfilm"><integer name="width" value="20"/><integer name="height" value="12"/></film>
+  </sensor>
+  <shape type="sphere"><point name="center" x="0" y="0" z="4"/></shape>
+  <emitter type="constant"/>
+</scene>)";
+
+std::string bundle() {
+  TempDir src;
+  src.write("scene.xml", kXml);
+  return pack_bundle(src.path.string(), {"scene.xml"});
+}
+
+uint64_t add_worker(Coordinator& c, const std::string& name) {
+  const BuildFingerprint& fp = build_fingerprint();
+  auto r = c.register_worker(json{{"name", name}, {"version", fp.version}, {"isa", fp.isa}, {"probe", fp.probe}});
+  EXPECT_TRUE(r.ok()) << r.status.detail;
+  return r.value.value("id", uint64_t(0));
+}
+
+CoordinatorOptions options(const TempDir& dir) {
+  CoordinatorOptions o;
+  o.data_dir = (dir.path / "data").string();
+  return o;
+}
+
+TEST(Coordinator, FailingWorkersAreKeptOffAndThenTheJobFails) {
+  TempDir dir;
+  Coordinator c(options(dir));
+  const uint64_t a = add_worker(c, "a"), b = add_worker(c, "b"), d = add_worker(c, "d");
+  auto job = c.submit_job(json{{"tile_size", 8}}, bundle());
+  ASSERT_TRUE(job.ok()) << job.status.detail;
+  const uint64_t id = job.value["id"];
+
+  auto fail = [&](uint64_t worker) {
+    auto l = c.lease(worker, 0);
+    EXPECT_TRUE(l.ok());
+    if (!l.value.is_object()) return false;
+    EXPECT_TRUE(c.fail_lease(worker, l.value["id"], json{{"error", "no GPU on " + std::to_string(worker)}}).ok());
+    return true;
+  };
+  ASSERT_TRUE(fail(a));
+  ASSERT_TRUE(fail(a));
+  EXPECT_TRUE(c.lease(a, 0).value.is_null()) << "worker a failed twice: kept off the job";
+  EXPECT_TRUE(c.lease(b, 0).value.is_object()) << "others still get its work";
+  ASSERT_TRUE(fail(d));
+  EXPECT_EQ(c.job_status(id).value["state"], "running");
+  ASSERT_TRUE(fail(b));  // the third distinct worker
+  json st = c.job_status(id).value;
+  EXPECT_EQ(st["state"], "failed");
+  EXPECT_NE(st.value("error", "").find("failed on 3 worker(s)"), std::string::npos) << st.dump();
+  EXPECT_NE(st.value("error", "").find("no GPU"), std::string::npos) << st.dump();
+  EXPECT_TRUE(c.lease(b, 0).value.is_null());
+  EXPECT_EQ(c.cancel_job(id).code, server::Code::Conflict);
+}
+
+TEST(Coordinator, StateSurvivesARestart) {
+  TempDir dir;
+  uint64_t id = 0, worker = 0;
+  json before;
+  {
+    Coordinator c(options(dir));
+    worker = add_worker(c, "w");
+    auto job = c.submit_job(json{{"tile_size", 8}, {"name", "persist"}, {"seed", 4}}, bundle());
+    ASSERT_TRUE(job.ok()) << job.status.detail;
+    id = job.value["id"];
+    // Render and deliver three units for real, and leave one lease hanging.
+    TempDir src;
+    src.write("scene.xml", kXml);
+    LoadResult loaded = load_scene(parse_scene_file(src.write("scene.xml", kXml)), LoadOptions{});
+    for (int i = 0; i < 3; ++i) {
+      auto l = c.lease(worker, 0).value;
+      ASSERT_TRUE(l.is_object());
+      TileResult r;
+      r.job_id = id;
+      r.tile = l["tile"];
+      r.pass = l["pass"];
+      r.sample_begin = l["sample_begin"];
+      r.sample_end = l["sample_end"];
+      auto rect = l["rect"].get<std::vector<int>>();
+      render_tile(*loaded.scene, {rect[0], rect[1], rect[2], rect[3]}, r.sample_begin, r.sample_end, 4, r.film);
+      auto up = c.upload_result(worker, l["id"], encode_tile_result(r));
+      ASSERT_TRUE(up.ok()) << up.status.detail;
+    }
+    ASSERT_TRUE(c.lease(worker, 0).value.is_object());
+    before = c.job_status(id).value;
+  }
+  Coordinator again(options(dir));
+  json after = again.job_status(id).value;
+  EXPECT_EQ(after["state"], "running");
+  EXPECT_EQ(after["name"], "persist");
+  EXPECT_EQ(after["units_done"], 3);
+  EXPECT_EQ(after["units_done"], before["units_done"]);
+  EXPECT_EQ(after["samples_done"], before["samples_done"]);
+  // The worker is known after the restart, and the hanging lease's unit is available again.
+  auto l = again.lease(worker, 0);
+  ASSERT_TRUE(l.ok()) << l.status.detail;
+  EXPECT_TRUE(l.value.is_object());
+  EXPECT_EQ(again.job_status(id).value["reissued_acknowledged_passes"], 0);
+  EXPECT_EQ(again.list_jobs().value["jobs"].size(), 1u);
+}
+
+TEST(Coordinator, ABrokenDataDirectoryIsAClearError) {
+  TempDir dir;
+  std::filesystem::create_directories(dir.path / "data");
+  dir.write("data/state.sqlite", "this is not a database");
+  try {
+    Coordinator c(options(dir));
+    ADD_FAILURE() << "expected an error";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("database"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace tessera::test

@@ -1,0 +1,106 @@
+// Strict parsing of the farm's JSON messages.
+#include "tessera/farm/protocol.h"
+
+#include <gtest/gtest.h>
+
+namespace tessera {
+namespace {
+
+using nlohmann::json;
+
+std::string parse_error(const json& j, bool require_scene = true) {
+  JobSettings s;
+  std::string error;
+  EXPECT_FALSE(job_settings_from_json(j, s, error, require_scene)) << j.dump();
+  return error;
+}
+
+TEST(Protocol, JobSettingsRoundTrip) {
+  JobSettings s;
+  s.name = "x";
+  s.scene = std::string(64, 'c');
+  s.spp = 37;
+  s.width = 100;
+  s.height = 75;
+  s.seed = 9;
+  s.tile_size = 24;
+  s.priority = -2;
+  s.defines = {{"spp", "4"}, {"res", "hi"}};
+  s.integrator = "volpath";
+  s.light_selection = "power";
+  JobSettings back;
+  std::string error;
+  ASSERT_TRUE(job_settings_from_json(to_json(s), back, error)) << error;
+  EXPECT_EQ(to_json(back), to_json(s));
+}
+
+TEST(Protocol, JobSettingsAreStrict) {
+  const std::string h(64, 'a');
+  EXPECT_NE(parse_error(json{{"scene", h}, {"spp_", 3}}).find("unknown field 'spp_'"), std::string::npos);
+  EXPECT_NE(parse_error(json{{"scene", h}, {"spp", 1.5}}).find("'spp' must be an integer"), std::string::npos);
+  EXPECT_NE(parse_error(json{{"scene", h}, {"seed", -1}}).find("'seed'"), std::string::npos);
+  EXPECT_NE(parse_error(json{{"scene", h}, {"width", "10"}}).find("'width'"), std::string::npos);
+  EXPECT_NE(parse_error(json{{"scene", h}, {"defines", json::array()}}).find("'defines'"), std::string::npos);
+  EXPECT_NE(parse_error(json{{"scene", "ABC"}}).find("hash"), std::string::npos);
+  EXPECT_NE(parse_error(json{{"spp", 3}}).find("missing field 'scene'"), std::string::npos);
+  EXPECT_NE(parse_error(json::array()).find("JSON object"), std::string::npos);
+  JobSettings s;
+  std::string error;
+  EXPECT_TRUE(job_settings_from_json(json{{"spp", 3}}, s, error, /*require_scene=*/false)) << error;
+  EXPECT_TRUE(job_settings_from_json(json{{"scene", h}, {"defines", {{"n", 3}}}}, s, error)) << error;
+  EXPECT_EQ(s.defines.at("n"), "3");
+}
+
+TEST(Protocol, LimitsNameTheField) {
+  JobLimits limits;
+  JobSettings s;
+  std::string error;
+  EXPECT_TRUE(check_job_limits(s, limits, error)) << error;
+  s.width = 1 << 20;
+  EXPECT_FALSE(check_job_limits(s, limits, error));
+  EXPECT_NE(error.find("width"), std::string::npos);
+  s = {};
+  s.spp = -1;
+  EXPECT_FALSE(check_job_limits(s, limits, error));
+  s = {};
+  s.tile_size = 1;
+  EXPECT_FALSE(check_job_limits(s, limits, error));
+  s = {};
+  s.integrator = "bdpt";
+  EXPECT_FALSE(check_job_limits(s, limits, error));
+  s = {};
+  s.width = s.height = 30000;
+  EXPECT_FALSE(check_job_limits(s, limits, error));
+  EXPECT_NE(error.find("pixels"), std::string::npos);
+}
+
+TEST(Protocol, LeaseRoundTripAndCacheKey) {
+  Lease l;
+  l.id = 3;
+  l.job_id = 4;
+  l.tile = 5;
+  l.pass = 6;
+  l.rect = {0, 8, 16, 24};
+  l.sample_begin = 7;
+  l.sample_end = 15;
+  l.settings.scene = std::string(64, 'd');
+  l.scene_file = "sub/scene.xml";
+  l.files = {"sub/scene.xml", "meshes/a.obj"};
+  Lease back;
+  std::string error;
+  ASSERT_TRUE(lease_from_json(to_json(l), back, error)) << error;
+  EXPECT_EQ(to_json(back), to_json(l));
+  json bad = to_json(l);
+  bad["rect"] = {1, 2};
+  EXPECT_FALSE(lease_from_json(bad, back, error));
+  // The cache key changes with anything that changes the loaded scene, not with the seed.
+  JobSettings a = l.settings, b = a;
+  b.seed = 99;
+  EXPECT_EQ(scene_cache_key(a, "s.xml"), scene_cache_key(b, "s.xml"));
+  b.defines["x"] = "1";
+  EXPECT_NE(scene_cache_key(a, "s.xml"), scene_cache_key(b, "s.xml"));
+  EXPECT_NE(scene_cache_key(a, "s.xml"), scene_cache_key(a, "t.xml"));
+}
+
+}  // namespace
+}  // namespace tessera

@@ -1,0 +1,84 @@
+// The tile-result wire format: exact round trip, and every kind of damage refused.
+#include "tessera/farm/tile_result.h"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <random>
+
+namespace tessera {
+namespace {
+
+TileResult sample_result() {
+  TileResult r;
+  r.job_id = 77;
+  r.tile = 5;
+  r.pass = 3;
+  r.sample_begin = 7;
+  r.sample_end = 15;
+  r.seconds = 0.25;
+  r.film.reset({10, 20, 23, 29});
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<float> u(0.f, 10.f);
+  for (int y = 20; y < 29; ++y)
+    for (int x = 10; x < 23; ++x)
+      for (int s = 0; s < 8; ++s) r.film.add_sample({x, y}, Rgb(u(rng), u(rng), u(rng)));
+  r.film.add_sample({12, 21}, Rgb(std::nanf(""), 0, 0));  // counted, not summed
+  r.film.counters.bounce_rays = 123;
+  return r;
+}
+
+TEST(TileResult, RoundTripsEveryBit) {
+  TileResult in = sample_result();
+  std::string bytes = encode_tile_result(in);
+  TileResult out;
+  std::string error;
+  ASSERT_TRUE(decode_tile_result(bytes, out, error)) << error;
+  EXPECT_EQ(out.job_id, 77u);
+  EXPECT_EQ(out.tile, 5u);
+  EXPECT_EQ(out.pass, 3u);
+  EXPECT_EQ(out.sample_begin, 7u);
+  EXPECT_EQ(out.sample_end, 15u);
+  EXPECT_EQ(out.seconds, 0.25);
+  EXPECT_EQ(out.film.rect(), in.film.rect());
+  EXPECT_EQ(out.film.counters.samples, in.film.counters.samples);
+  EXPECT_EQ(out.film.counters.nonfinite, 1u);
+  EXPECT_EQ(out.film.counters.bounce_rays, 123u);
+  ASSERT_EQ(out.film.pixels().size(), in.film.pixels().size());
+  EXPECT_EQ(std::memcmp(out.film.pixels().data(), in.film.pixels().data(), in.film.pixels().size() * sizeof(PixelSums)), 0);
+  std::printf("13x9 tile: %zu bytes raw, %zu compressed\n", size_t(13 * 9 * 56 + 124), bytes.size());
+}
+
+TEST(TileResult, RefusesDamage) {
+  const std::string bytes = encode_tile_result(sample_result());
+  TileResult out;
+  std::string error;
+  EXPECT_FALSE(decode_tile_result("", out, error));
+  EXPECT_FALSE(decode_tile_result(bytes.substr(0, bytes.size() - 1), out, error));
+  EXPECT_FALSE(decode_tile_result(bytes.substr(0, 10), out, error));
+  EXPECT_FALSE(decode_tile_result(std::string(1000, 'x'), out, error));
+  // A flipped byte is refused (zstd's framing or the checksum), or, where it only touches framing
+  // that does not change the content (a few header bits), decodes to exactly the original: the
+  // SHA-256 covers the decompressed content, so damaged sums can never be accepted.
+  const TileResult original = sample_result();
+  int refused = 0, harmless = 0;
+  for (size_t i = 0; i < bytes.size(); ++i) {
+    std::string bad = bytes;
+    bad[i] ^= 0x10;
+    if (!decode_tile_result(bad, out, error)) {
+      ++refused;
+      continue;
+    }
+    ASSERT_EQ(std::memcmp(out.film.pixels().data(), original.film.pixels().data(),
+                          original.film.pixels().size() * sizeof(PixelSums)), 0) << "byte " << i;
+    ++harmless;
+  }
+  EXPECT_GT(refused, int(bytes.size()) * 99 / 100);
+  std::printf("flipped bytes: %d refused, %d harmless framing\n", refused, harmless);
+  // A rect larger than the limit is refused before anything is allocated for it.
+  EXPECT_FALSE(decode_tile_result(bytes, out, error, 100));
+  EXPECT_NE(error.find("implausible"), std::string::npos) << error;
+}
+
+}  // namespace
+}  // namespace tessera
