@@ -101,6 +101,16 @@ Result<std::string> Coordinator::scene_bundle_path(const std::string& hash) {
   return path;
 }
 
+Result<std::string> Coordinator::scene_bundle(const std::string& hash) {
+  Result<std::string> path = scene_bundle_path(hash);
+  if (!path.ok()) return path.status;
+  try {
+    return read_file(path.value);
+  } catch (const std::exception& e) {
+    return internal_error(e);
+  }
+}
+
 Result<json> Coordinator::submit_job(const json& body, const std::string& bundle) {
   Impl& s = *impl_;
   JobSettings settings;

@@ -3,8 +3,6 @@
 #include <httplib.h>
 #include <spdlog/spdlog.h>
 
-#include <fstream>
-#include <sstream>
 
 namespace tessera::server {
 
@@ -83,12 +81,9 @@ void install_routes(httplib::Server& http, Coordinator& c) {
     send(res, c.upload_scene(bundle), 201);
   });
   http.Get(R"(/api/v1/scenes/([0-9a-f]{64}))", [&c](const httplib::Request& req, httplib::Response& res) {
-    Result<std::string> path = c.scene_bundle_path(req.matches[1].str());
-    if (!path.ok()) return send_error(res, path.status);
-    std::ifstream in(path.value, std::ios::binary);
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    res.set_content(ss.str(), "application/octet-stream");
+    Result<std::string> bundle = c.scene_bundle(req.matches[1].str());
+    if (!bundle.ok()) return send_error(res, bundle.status);
+    res.set_content(bundle.value, "application/octet-stream");
   });
 
   http.Post("/api/v1/jobs", [&c](const httplib::Request& req, httplib::Response& res) {

@@ -140,13 +140,7 @@ TEST_F(FarmApi, WorkerProtocolRefusesBadBuildsAndBadResults) {
   // Render the unit for real, then break it in every way.
   auto abs = std::filesystem::absolute(cornell());
   LoadedJobScene scene = load_job_scene(abs.parent_path().string(), abs.filename().string(), lease.settings, /*confine=*/false);
-  TileResult result;
-  result.job_id = lease.job_id;
-  result.tile = lease.tile;
-  result.pass = lease.pass;
-  result.sample_begin = lease.sample_begin;
-  result.sample_end = lease.sample_end;
-  render_tile(*scene.loaded.scene, lease.rect, lease.sample_begin, lease.sample_end, lease.settings.seed, result.film);
+  TileResult result = render_lease(*scene.loaded.scene, lease);
   const std::string bytes = encode_tile_result(result);
   const std::string upload = w + "/results?lease=" + std::to_string(lease.id);
   auto post = [&](const std::string& b) { return c.post_bytes(upload, b, "application/x-tessera-tile"); };

@@ -1,6 +1,7 @@
 #include "tessera/worker/worker.h"
 
 #include "tessera/farm/build_fingerprint.h"
+#include "tessera/farm/job_scene.h"
 #include "tessera/farm/tile_result.h"
 #include "tessera/render/renderer.h"
 
@@ -183,15 +184,7 @@ void Worker::process(const Lease& lease) {
                             json{{"error", e.what()}}, 10);
     return;
   }
-  TileResult result;
-  result.job_id = lease.job_id;
-  result.tile = lease.tile;
-  result.pass = lease.pass;
-  result.sample_begin = lease.sample_begin;
-  result.sample_end = lease.sample_end;
-  const auto t0 = Clock::now();
-  render_tile(*scene->scene, lease.rect, lease.sample_begin, lease.sample_end, lease.settings.seed, result.film);
-  result.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  TileResult result = render_lease(*scene->scene, lease);
   ++stats_.passes_rendered;
   const bool dropped = finish();
   if (dropped) return;

@@ -2,9 +2,11 @@
 
 #include "tessera/farm/bundle.h"
 #include "tessera/light/light_sampler.h"
+#include "tessera/render/renderer.h"
 #include "tessera/scene/error.h"
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 
 namespace tessera {
@@ -57,6 +59,19 @@ JobPlan make_job_plan(const std::string& bundle_dir, const std::string& scene_fi
     if (std::find(plan.files.begin(), plan.files.end(), rel) == plan.files.end()) plan.files.push_back(rel);
   }
   return plan;
+}
+
+TileResult render_lease(const Scene& scene, const Lease& lease) {
+  TileResult result;
+  result.job_id = lease.job_id;
+  result.tile = lease.tile;
+  result.pass = lease.pass;
+  result.sample_begin = lease.sample_begin;
+  result.sample_end = lease.sample_end;
+  const auto t0 = std::chrono::steady_clock::now();
+  render_tile(scene, lease.rect, lease.sample_begin, lease.sample_end, lease.settings.seed, result.film);
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return result;
 }
 
 nlohmann::json to_json(const JobPlan& p) {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "tessera/farm/protocol.h"
+#include "tessera/farm/tile_result.h"
 #include "tessera/scene/load_context.h"
 
 #include <string>
@@ -38,6 +39,9 @@ LoadedJobScene load_job_scene(const std::string& bundle_dir, const std::string& 
 /// The plan for a loaded scene (`files` made relative to bundle_dir).
 JobPlan make_job_plan(const std::string& bundle_dir, const std::string& scene_file, const JobSettings& settings,
                       const LoadedJobScene& scene);
+
+/// Renders a lease's unit (what a worker does with it), timed.
+TileResult render_lease(const Scene& scene, const Lease& lease);
 
 nlohmann::json to_json(const JobPlan& p);
 [[nodiscard]] bool job_plan_from_json(const nlohmann::json& j, JobPlan& out, std::string& error);

@@ -50,6 +50,8 @@ class Coordinator {
   Result<nlohmann::json> upload_scene(const std::string& bundle);
   /// Path of the stored bundle file.
   Result<std::string> scene_bundle_path(const std::string& hash);
+  /// The stored bundle's bytes (what workers download).
+  Result<std::string> scene_bundle(const std::string& hash);
 
   // Jobs. `bundle` non-empty: uploaded in the same request (the settings' scene may be empty).
   Result<nlohmann::json> submit_job(const nlohmann::json& settings, const std::string& bundle);
