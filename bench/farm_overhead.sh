@@ -42,9 +42,10 @@ for workers in 1 2; do
   kill -TERM "$server"; wait "$server" || true
   units=$(echo "$status" | python3 -c 'import json,sys; print(json.load(sys.stdin)["units_total"])')
   bytes=$(echo "$status" | python3 -c 'import json,sys; print(json.load(sys.stdin)["result_bytes"])')
+  lbytes=$(echo "$status" | python3 -c 'import json,sys; print(json.load(sys.stdin)["lease_bytes"])')
   cpu=$(echo "($u1 + $s1 - $u0 - $s0) / $(getconf CLK_TCK)" | bc -l)
   same=$("$build/cli/tessera" compare "$data/farm.exr" "$tmp/local.exr" | grep -o 'rel_mse=[^ ]*')
-  printf "%-28s %8.2f s  (%.2fx local)  %d units, coordinator CPU %.2f ms/unit, %.0f bytes/unit, %s\n" \
+  printf "%-28s %8.2f s  (%.2fx local)  %d units, coordinator CPU %.2f ms/unit, result %.0f + lease %.0f bytes/unit, %s\n" \
       "farm, $workers local worker(s) x $threads" "$wall" "$(echo "$wall / $local_s" | bc -l)" "$units" \
-      "$(echo "1000 * $cpu / $units" | bc -l)" "$(echo "$bytes / $units" | bc -l)" "$same"
+      "$(echo "1000 * $cpu / $units" | bc -l)" "$(echo "$bytes / $units" | bc -l)" "$(echo "$lbytes / $units" | bc -l)" "$same"
 done

@@ -2,6 +2,7 @@
 #include "coordinator_impl.h"
 
 #include "tessera/farm/tile_result.h"
+#include "tessera/image/image.h"
 
 #include <spdlog/spdlog.h>
 
@@ -42,6 +43,7 @@ std::string prepare_data_dir(const std::string& dir) {
   fs::create_directories(fs::path(dir) / "bundles");
   fs::create_directories(fs::path(dir) / "scenes");
   fs::create_directories(fs::path(dir) / "tmp");
+  fs::create_directories(fs::path(dir) / "images");
   return (fs::path(dir) / "state.sqlite").string();
 }
 }  // namespace
@@ -71,6 +73,16 @@ Coordinator::Coordinator(CoordinatorOptions options) : impl_(std::make_unique<Im
     job->error = row.error;
     job->started = row.started;
     job->finished = row.finished;
+    // A job that ended has its image on disk: only its bookkeeping is rebuilt, not its film.
+    const bool from_image = is_terminal(job->phase) && fs::exists(s.image_path(row.id));
+    if (from_image) {
+      s.store.for_each_result(row.id, [&](ResultRow&& r) {
+        if (r.tile < job->num_tiles() && r.pass < job->num_passes()) job->mark_done(job->unit(r.tile, r.pass), r.worker);
+      }, /*with_data=*/false);
+      job->release_film();
+      s.jobs.emplace(row.id, std::move(job));
+      continue;
+    }
     s.store.for_each_result(row.id, [&](ResultRow&& r) {
       TileResult result;
       std::string err;
@@ -82,6 +94,7 @@ Coordinator::Coordinator(CoordinatorOptions options) : impl_(std::make_unique<Im
       }
     });
     if (!is_terminal(job->phase)) ++resumed;
+    else s.save_phase(*job);  // ended before its image was written
     s.jobs.emplace(row.id, std::move(job));
   }
   if (!s.jobs.empty())
@@ -110,8 +123,21 @@ void Coordinator::Impl::end_lease(std::map<uint64_t, LeaseInfo>::iterator it) {
   work_cv.notify_all();
 }
 
+std::string Coordinator::Impl::image_path(uint64_t job) const {
+  return (fs::path(opt.data_dir) / "images" / (std::to_string(job) + ".exr")).string();
+}
+
 void Coordinator::Impl::save_phase(JobState& job) {
   store.set_job_state(job.id(), phase_name(job.phase), job.error, job.started, job.finished);
+  if (is_terminal(job.phase) && job.has_film()) {
+    const std::string path = image_path(job.id());
+    write_image(path + ".tmp.exr", job.image(),
+                {{"tessera_version", TESSERA_VERSION}, {"tessera_job", std::to_string(job.id())},
+                 {"tessera_spp", std::to_string(job.plan().settings.spp)},
+                 {"tessera_seed", std::to_string(job.plan().settings.seed)}});
+    fs::rename(path + ".tmp.exr", path);
+    job.release_film();
+  }
 }
 
 void Coordinator::Impl::reap_loop() {

@@ -55,8 +55,9 @@ struct Coordinator::Impl {
   WorkerInfo* find_worker(uint64_t id);
   /// Under `mu`: ends a lease (the unit becomes available again unless done).
   void end_lease(std::map<uint64_t, LeaseInfo>::iterator it);
-  /// Under `mu`: persists a job's phase.
+  /// Under `mu`: persists a job's phase; a job that ended writes its image and drops its film.
   void save_phase(JobState& job);
+  std::string image_path(uint64_t job) const;
   /// Under `mu`: job status as JSON.
   nlohmann::json status_json(const JobState& job);
   /// Expires leases and marks silent workers lost, once a second.

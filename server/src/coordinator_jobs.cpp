@@ -205,6 +205,7 @@ json Coordinator::Impl::status_json(const JobState& job) {
             {"workers", workers_json},
             {"duplicate_results", job.duplicates},
             {"result_bytes", job.result_bytes},
+            {"lease_bytes", job.lease_bytes},
             {"nonfinite_samples", job.counters().nonfinite}};
   try {
     j["leases_issued"] = store.leases_issued(job.id());
@@ -243,8 +244,15 @@ Result<ImageBytes> Coordinator::job_image(uint64_t id, const std::string& format
     std::lock_guard<std::mutex> lock(s.mu);
     auto it = s.jobs.find(id);
     if (it == s.jobs.end()) return make_error(Code::NotFound, "unknown_job", "no job " + std::to_string(id));
-    image = it->second->image();
     plan = it->second->plan();
+    if (it->second->has_film()) image = it->second->image();
+  }
+  if (image.width() == 0) {  // an ended job: its image is on disk
+    try {
+      image = read_exr(s.image_path(id));
+    } catch (const std::exception& e) {
+      return internal_error(e);
+    }
   }
   static std::atomic<uint64_t> counter{0};
   const std::string tmp = (fs::path(s.opt.data_dir) / "tmp" /

@@ -112,7 +112,9 @@ Result<json> Coordinator::lease(uint64_t worker, double wait_seconds) {
           s.save_phase(*best);
         }
         w->state = "busy";
-        return to_json(l);
+        json j = to_json(l);
+        best->lease_bytes += j.dump().size();
+        return j;
       } catch (const std::exception& e) {
         return internal_error(e);
       }

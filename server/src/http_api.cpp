@@ -10,9 +10,10 @@ using nlohmann::json;
 
 namespace {
 
-void send_json(httplib::Response& res, int status, const json& body) {
+// Indented for people reading curl output; `compact` for the workers' hot path (leases).
+void send_json(httplib::Response& res, int status, const json& body, bool compact = false) {
   res.status = status;
-  res.set_content(body.dump(2) + "\n", "application/json");
+  res.set_content((compact ? body.dump() : body.dump(2)) + "\n", "application/json");
 }
 
 void send_error(httplib::Response& res, const Status& s) {
@@ -132,7 +133,7 @@ void install_routes(httplib::Server& http, Coordinator& c) {
       res.set_header("Retry-After", "1");
       return;
     }
-    send_json(res, 200, lease.value);
+    send_json(res, 200, lease.value, /*compact=*/true);
   });
   http.Post(R"(/api/v1/workers/(\d+)/heartbeat)", [&c](const httplib::Request& req, httplib::Response& res) {
     uint64_t id;

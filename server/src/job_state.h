@@ -53,10 +53,19 @@ class JobState {
   bool is_done(size_t unit) const { return done_[unit]; }
   /// Adds a verified result; false when the unit was already done (a duplicate).
   bool add_result(size_t unit, FilmTile&& tile, uint64_t worker);
+  /// Marks a unit done without its sums (a finished job resumed from its stored image).
+  void mark_done(size_t unit, uint64_t worker);
 
-  /// Mean radiance over the film window (zero where no pass has arrived).
-  Image image() const { return film_.to_image(); }
-  const Film& film() const { return film_; }
+  /// Mean radiance over the film window (zero where no pass has arrived). Only with has_film().
+  Image image() const { return film_->to_image(); }
+  const Film& film() const { return *film_; }
+  /// A finished job's film is dropped once its image is on disk (a 1080p film holds 116 MB of
+  /// sums); the image is then served from the file.
+  bool has_film() const { return film_ != nullptr; }
+  void release_film() {
+    film_.reset();
+    waiting_.clear();
+  }
   const RenderCounters& counters() const { return counters_; }
   const std::map<uint64_t, uint64_t>& samples_by_worker() const { return samples_by_worker_; }
 
@@ -68,6 +77,7 @@ class JobState {
   std::string last_failure;
   uint64_t duplicates = 0;
   uint64_t result_bytes = 0;  // compressed bytes of the accepted results (the network cost)
+  uint64_t lease_bytes = 0;   // JSON bytes of the leases handed out
 
  private:
   uint64_t id_;
@@ -84,7 +94,7 @@ class JobState {
   size_t done_units_ = 0, first_open_ = 0;
   uint64_t total_samples_ = 0, done_samples_ = 0;
   std::map<uint64_t, uint64_t> samples_by_worker_;
-  Film film_;
+  std::unique_ptr<Film> film_;
   RenderCounters counters_;
 };
 

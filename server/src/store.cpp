@@ -149,8 +149,9 @@ bool Store::add_result(uint64_t job, uint32_t tile, uint32_t pass, uint64_t work
   return !st.constraint();
 }
 
-void Store::for_each_result(uint64_t job, const std::function<void(ResultRow&&)>& fn) {
-  Stmt st(db_, "SELECT tile, pass, worker, data FROM results WHERE job = ? ORDER BY pass, tile");
+void Store::for_each_result(uint64_t job, const std::function<void(ResultRow&&)>& fn, bool with_data) {
+  Stmt st(db_, with_data ? "SELECT tile, pass, worker, data FROM results WHERE job = ? ORDER BY pass, tile"
+                         : "SELECT tile, pass, worker, '' FROM results WHERE job = ? ORDER BY pass, tile");
   st.bind(int64_t(job));
   while (st.step()) fn(ResultRow{uint32_t(st.i(0)), uint32_t(st.i(1)), uint64_t(st.i(2)), st.s(3)});
 }

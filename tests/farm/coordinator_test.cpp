@@ -2,6 +2,7 @@
 // the reason, and state that survives a restart.
 #include "tessera/farm/build_fingerprint.h"
 #include "tessera/farm/bundle.h"
+#include "tessera/farm/job_scene.h"
 #include "tessera/farm/tile_result.h"
 #include "tessera/render/renderer.h"
 #include "tessera/scene/load_context.h"
@@ -118,6 +119,46 @@ TEST(Coordinator, StateSurvivesARestart) {
   EXPECT_TRUE(l.value.is_object());
   EXPECT_EQ(again.job_status(id).value["reissued_acknowledged_passes"], 0);
   EXPECT_EQ(again.list_jobs().value["jobs"].size(), 1u);
+}
+
+// Leases and delivers one unit for real; false when there was nothing to lease.
+bool deliver_one(Coordinator& c, uint64_t worker, const Scene& scene, uint32_t seed) {
+  json l = c.lease(worker, 0).value;
+  if (!l.is_object()) return false;
+  Lease lease;
+  std::string error;
+  EXPECT_TRUE(lease_from_json(l, lease, error)) << error;
+  lease.settings.seed = seed;
+  auto up = c.upload_result(worker, lease.id, encode_tile_result(render_lease(scene, lease)));
+  EXPECT_TRUE(up.ok()) << up.status.detail;
+  return true;
+}
+
+TEST(Coordinator, FinishedJobIsServedFromItsImageAfterARestart) {
+  TempDir dir;
+  TempDir src;
+  LoadResult loaded = load_scene(parse_scene_file(src.write("scene.xml", kXml)), LoadOptions{});
+  uint64_t id = 0;
+  std::string exr_before;
+  {
+    Coordinator c(options(dir));
+    const uint64_t w = add_worker(c, "w");
+    auto job = c.submit_job(json{{"tile_size", 8}, {"seed", 2}}, bundle());
+    ASSERT_TRUE(job.ok()) << job.status.detail;
+    id = job.value["id"];
+    while (deliver_one(c, w, *loaded.scene, 2)) {
+    }
+    EXPECT_EQ(c.job_status(id).value["state"], "done");
+    exr_before = c.job_image(id, "pfm").value.bytes;
+  }
+  Coordinator again(options(dir));
+  json st = again.job_status(id).value;
+  EXPECT_EQ(st["state"], "done");
+  EXPECT_EQ(st["units_done"], st["units_total"]);
+  auto image = again.job_image(id, "pfm");
+  ASSERT_TRUE(image.ok()) << image.status.detail;
+  EXPECT_EQ(image.value.bytes, exr_before) << "the stored image is the image";
+  EXPECT_FALSE(exr_before.empty());
 }
 
 TEST(Coordinator, ABrokenDataDirectoryIsAClearError) {

@@ -139,6 +139,12 @@ TEST(FarmIntegration, HigherPriorityJobOvertakesAndCancelStopsAJob) {
   EXPECT_EQ(farm.client().get("/api/v1/jobs/" + std::to_string(low_id) + "/image?format=png").status, 200);
   uint64_t again = farm.submit(cornell(), small_job());
   EXPECT_EQ(farm.wait_job(again).value("state", ""), "done");
+  // Three jobs of one bundle: the worker downloaded it once.
+  std::ifstream log(farm.log("worker0"));
+  std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+  size_t downloads = 0;
+  for (size_t at = 0; (at = text.find("downloaded scene bundle", at)) != std::string::npos; ++at) ++downloads;
+  EXPECT_EQ(downloads, 1u) << text;
 }
 
 TEST(FarmIntegration, WorkerJoiningMidJobGetsWork) {
@@ -174,6 +180,28 @@ TEST(FarmIntegration, WorkerStopsCleanlyOnSigterm) {
   // What it had not finished goes to the next worker at once (no lease timeout to wait for).
   farm.add_worker();
   EXPECT_EQ(farm.wait_job(id).value("state", ""), "done");
+}
+
+TEST(FarmIntegration, HeartbeatsKeepLongTilesLeased) {
+  TESSERA_REQUIRE_FILE(cornell());
+  // One 128x96 tile; its 64-sample pass takes seconds on one thread, longer than the 1.5 s lease
+  // timeout: only the heartbeats keep it from being re-issued.
+  Farm farm({"--lease-timeout", "1.5"});
+  farm.start_server();
+  farm.add_worker();
+  ASSERT_TRUE(farm.wait_workers(1));
+  JobSettings s;
+  s.spp = 128;
+  s.width = 128;
+  s.height = 96;
+  s.tile_size = 128;
+  uint64_t id = farm.submit(cornell(), s);
+  ASSERT_GT(id, 0u);
+  nlohmann::json st = farm.wait_job(id);
+  ASSERT_EQ(st.value("state", ""), "done");
+  EXPECT_EQ(st.value("leases_issued", 0), st.value("units_total", -1)) << "a leased unit was re-issued";
+  EXPECT_GT(st.value("elapsed_seconds", 0.0), 1.5) << "the job was too short to need a heartbeat";
+  EXPECT_EQ(st.value("duplicate_results", -1), 0);
 }
 
 // The client as users run it: `tessera submit ... -o`, `tessera jobs`, `tessera cancel`.

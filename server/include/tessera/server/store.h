@@ -63,8 +63,8 @@ class Store {
   /// Commits an acknowledged result. False if (job, tile, pass) already had one (a duplicate).
   bool add_result(uint64_t job, uint32_t tile, uint32_t pass, uint64_t worker, const std::string& data,
                   double now);
-  /// Calls `fn` for every result of `job`, ordered by pass then tile.
-  void for_each_result(uint64_t job, const std::function<void(ResultRow&&)>& fn);
+  /// Calls `fn` for every result of `job`, ordered by pass then tile (`with_data`: the bytes too).
+  void for_each_result(uint64_t job, const std::function<void(ResultRow&&)>& fn, bool with_data = true);
   /// Leases issued for a pass after that pass had been acknowledged (should be 0: the measure the
   /// restart test reads).
   uint64_t reissued_after_ack(uint64_t job);
