@@ -65,7 +65,7 @@ Result<json> Coordinator::lease(uint64_t worker, double wait_seconds) {
     std::atomic<int>& n;
     ~PollSlot() { --n; }
   } slot{s.waiting_polls};
-  if (s.waiting_polls.fetch_add(1) >= s.opt.max_waiting_polls) wait_seconds = 0;
+  if (s.waiting_polls.fetch_add(1) >= s.opt.max_waiting_polls || !(wait_seconds >= 0)) wait_seconds = 0;  // NaN too
   std::unique_lock<std::mutex> lock(s.mu);
   WorkerInfo* w = s.find_worker(worker);
   if (!w) return unknown_worker(worker);
@@ -141,7 +141,13 @@ Result<json> Coordinator::heartbeat(uint64_t worker, const json& body) {
   auto leases = body.is_object() ? body.find("leases") : body.end();
   if (body.is_object() && leases != body.end() && leases->is_array()) {
     for (const json& item : *leases) {
-      if (!item.is_object() || !item.contains("id") || !item["id"].is_number_unsigned()) continue;
+      auto number = [&item](const char* key) {
+        auto it = item.find(key);
+        return it != item.end() && it->is_number_unsigned();
+      };
+      if (!item.is_object() || !number("id") || !number("job") || !number("tile") || !number("pass"))
+        return make_error(Code::BadRequest, "bad_heartbeat",
+                          "each lease in 'leases' must be {\"id\", \"job\", \"tile\", \"pass\"} with unsigned integers");
       const uint64_t id = item["id"].get<uint64_t>();
       auto it = s.leases.find(id);
       if (it != s.leases.end() && it->second.worker == worker) {
@@ -156,15 +162,15 @@ Result<json> Coordinator::heartbeat(uint64_t worker, const json& body) {
         continue;
       }
       // Unknown (a lease from before a coordinator restart): keep it if its work is still wanted.
-      uint64_t job_id = item.value("job", uint64_t(0));
-      uint32_t tile = item.value("tile", 0u), pass = item.value("pass", 0u);
+      const uint64_t job_id = item["job"].get<uint64_t>();
+      const uint64_t tile = item["tile"].get<uint64_t>(), pass = item["pass"].get<uint64_t>();
       auto job = s.jobs.find(job_id);
       if (job == s.jobs.end() || is_terminal(job->second->phase) || tile >= job->second->num_tiles() ||
           pass >= job->second->num_passes() || job->second->is_done(job->second->unit(tile, pass))) {
         drop.push_back(id);
         continue;
       }
-      size_t unit = job->second->unit(tile, pass);
+      size_t unit = job->second->unit(uint32_t(tile), uint32_t(pass));
       job->second->lease_started(unit);
       s.leases[id] = LeaseInfo{id, job_id, worker, unit,
                                Clock::now() + std::chrono::duration_cast<Clock::duration>(

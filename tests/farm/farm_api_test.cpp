@@ -123,6 +123,10 @@ TEST_F(FarmApi, WorkerProtocolRefusesBadBuildsAndBadResults) {
   ASSERT_EQ(reg.status, 201) << reg.body;
   const std::string w = "/api/v1/workers/" + std::to_string(reg.json()["id"].get<uint64_t>());
   EXPECT_EQ(c.post_json(w + "/lease?wait=0", json::object()).status, 204);
+  EXPECT_EQ(c.post_json(w + "/lease?wait=nan", json::object(), 5).status, 204);
+  expect_error(c.post_json(w + "/heartbeat", json{{"leases", json::array({json{{"id", "x"}}})}}), 400);
+  expect_error(c.post_bytes(w + "/heartbeat", "[", "application/json"), 400);
+  EXPECT_EQ(c.post_json(w + "/heartbeat", json{{"leases", json::array()}}).status, 200);
 
   JobSettings settings;
   settings.spp = 3;
