@@ -27,6 +27,12 @@ std::string default_server_url() {
 
 namespace {
 
+// The coordinator's client, with the client token from --token-file or $TESSERA_CLIENT_TOKEN.
+farm::FarmClient make_client(const std::string& server, const std::string& token_file) {
+  return farm::FarmClient(server.empty() ? default_server_url() : server,
+                          resolve_token("", token_file, "TESSERA_CLIENT_TOKEN"));
+}
+
 std::string extension_of(const std::string& path) {
   std::string ext = fs::path(path).extension().string();
   for (auto& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
@@ -81,7 +87,13 @@ int run_submit(const SubmitOptions& o) {
       return 2;
     }
   }
-  farm::FarmClient client(o.server.empty() ? default_server_url() : o.server);
+  farm::FarmClient client("");
+  try {
+    client = make_client(o.server, o.token_file);
+  } catch (const std::exception& e) {
+    std::cerr << "tessera submit: " << e.what() << "\n";
+    return 2;
+  }
   std::string why;
   if (!client.valid(&why)) {
     std::cerr << "tessera submit: " << why << "\n";
@@ -138,7 +150,13 @@ int run_submit(const SubmitOptions& o) {
 }
 
 int run_jobs(const JobsOptions& o) {
-  farm::FarmClient client(o.server.empty() ? default_server_url() : o.server);
+  farm::FarmClient client("");
+  try {
+    client = make_client(o.server, o.token_file);
+  } catch (const std::exception& e) {
+    std::cerr << "tessera: " << e.what() << "\n";
+    return 2;
+  }
   farm::HttpReply r = client.get("/api/v1/jobs");
   json j = r.json();
   if (!r.ok() || !j.is_object()) {
@@ -154,7 +172,13 @@ int run_jobs(const JobsOptions& o) {
 }
 
 int run_cancel(const JobsOptions& o) {
-  farm::FarmClient client(o.server.empty() ? default_server_url() : o.server);
+  farm::FarmClient client("");
+  try {
+    client = make_client(o.server, o.token_file);
+  } catch (const std::exception& e) {
+    std::cerr << "tessera: " << e.what() << "\n";
+    return 2;
+  }
   farm::HttpReply r = client.del("/api/v1/jobs/" + std::to_string(o.cancel_id));
   if (!r.ok()) {
     std::cerr << "tessera cancel: " << r.describe() << "\n";

@@ -72,7 +72,18 @@ std::string bundle_of(const httplib::Request& req) {
 
 }  // namespace
 
-void install_routes(httplib::Server& http, Coordinator& c) {
+void install_routes(httplib::Server& http, Coordinator& c, const AuthTokens& tokens) {
+  // Runs before the body is read: a stranger's upload is refused without being received (the
+  // connection is then closed). The answer is the same for a missing and a wrong token.
+  http.set_pre_routing_handler([tokens](const httplib::Request& req, httplib::Response& res) {
+    if (authorized(tokens, required_access(req.method, req.path), req.get_header_value("Authorization")))
+      return httplib::Server::HandlerResponse::Unhandled;
+    res.set_header("WWW-Authenticate", "Bearer");
+    res.set_header("Connection", "close");  // the unread body must not be taken for a next request
+    send_json(res, 401, json{{"error", "unauthorized"}, {"detail", "a valid bearer token is required"}});
+    return httplib::Server::HandlerResponse::Handled;
+  });
+
   http.Get("/healthz", [&c](const httplib::Request&, httplib::Response& res) { send_json(res, 200, c.health()); });
 
   http.Post("/api/v1/scenes", [&c](const httplib::Request& req, httplib::Response& res) {

@@ -1,5 +1,6 @@
 #include "tessera/server/server_app.h"
 
+#include "tessera/farm/protocol.h"
 #include "tessera/server/http_api.h"
 
 #include <CLI/CLI.hpp>
@@ -35,6 +36,10 @@ int parse_server_args(int argc, char** argv, ServerOptions& o) {
   app.add_option("--max-poll-wait", c.max_poll_wait, "longest lease long poll, seconds")
       ->check(CLI::Range(0.0, 30.0))->capture_default_str();
   app.add_option("--max-upload", c.max_upload_bytes, "largest scene bundle accepted, bytes")->capture_default_str();
+  app.add_option("--client-token", o.client_token, "bearer token for clients (else $TESSERA_CLIENT_TOKEN)");
+  app.add_option("--client-token-file", o.client_token_file, "read the client token from this file");
+  app.add_option("--worker-token", o.worker_token, "bearer token for workers (else $TESSERA_WORKER_TOKEN)");
+  app.add_option("--worker-token-file", o.worker_token_file, "read the worker token from this file");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -57,7 +62,12 @@ std::string find_worker_binary(const ServerOptions& o) {
 }
 
 pid_t spawn_worker(const std::string& binary, const std::string& url, int threads, int index,
-                   const std::string& cache) {
+                   const std::string& cache, const std::string& token) {
+  // The worker token travels in the environment (never on a command line that `ps` shows).
+  std::vector<std::string> env;
+  for (char** e = environ; *e; ++e)
+    if (std::string(*e).rfind("TESSERA_WORKER_TOKEN=", 0) != 0) env.emplace_back(*e);
+  if (!token.empty()) env.push_back("TESSERA_WORKER_TOKEN=" + token);
   std::vector<std::string> args = {binary, "--server", url, "--threads", std::to_string(threads),
                                    "--name", "local-" + std::to_string(index), "--cache-dir", cache};
   pid_t pid = fork();
@@ -68,7 +78,10 @@ pid_t spawn_worker(const std::string& binary, const std::string& url, int thread
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
-    execv(binary.c_str(), argv.data());
+    std::vector<char*> envp;
+    for (auto& e : env) envp.push_back(e.data());
+    envp.push_back(nullptr);
+    execve(binary.c_str(), argv.data(), envp.data());
     std::fprintf(stderr, "tessera-server: cannot run %s: %s\n", binary.c_str(), std::strerror(errno));
     _exit(127);
   }
@@ -101,6 +114,17 @@ int run_server(const ServerOptions& o) {
     return 2;
   }
 
+  AuthTokens tokens;
+  try {
+    tokens.client = resolve_token(o.client_token, o.client_token_file, "TESSERA_CLIENT_TOKEN");
+    tokens.worker = resolve_token(o.worker_token, o.worker_token_file, "TESSERA_WORKER_TOKEN");
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "tessera-server: %s\n", e.what());
+    return 2;
+  }
+  if (!tokens.enabled() && host != "127.0.0.1" && host != "localhost" && host != "::1")
+    spdlog::warn("no client or worker token: anyone who can reach {} can use this farm", o.listen);
+
   std::unique_ptr<Coordinator> coordinator;
   try {
     coordinator = std::make_unique<Coordinator>(o.coordinator);
@@ -117,7 +141,7 @@ int run_server(const ServerOptions& o) {
   http.set_keep_alive_timeout(2);
   http.set_read_timeout(60);
   http.set_payload_max_length(size_t(o.coordinator.max_upload_bytes) + (size_t(16) << 20));
-  install_routes(http, *coordinator);
+  install_routes(http, *coordinator, tokens);
   // cpp-httplib 0.11 listens with a backlog of 5; a few hundred workers connecting at once would
   // overflow it (dropped handshakes, failed requests). Keep the socket and widen the backlog after
   // bind: listen() on a listening socket only changes its backlog.
@@ -147,7 +171,7 @@ int run_server(const ServerOptions& o) {
   auto cache = [&](int i) {
     return (fs::path(o.coordinator.data_dir) / "local-workers" / std::to_string(i)).string();
   };
-  for (int i = 0; i < o.local_workers; ++i) children[size_t(i)] = spawn_worker(binary, url, per_worker, i, cache(i));
+  for (int i = 0; i < o.local_workers; ++i) children[size_t(i)] = spawn_worker(binary, url, per_worker, i, cache(i), tokens.worker);
 
   int exit_code = 0;
   for (;;) {
@@ -161,7 +185,7 @@ int run_server(const ServerOptions& o) {
       int status = 0;
       if (children[size_t(i)] > 0 && waitpid(children[size_t(i)], &status, WNOHANG) == children[size_t(i)]) {
         spdlog::warn("local worker {} exited (status {}); restarting it", i, status);
-        children[size_t(i)] = spawn_worker(binary, url, per_worker, i, cache(i));
+        children[size_t(i)] = spawn_worker(binary, url, per_worker, i, cache(i), tokens.worker);
       }
     }
   }

@@ -26,7 +26,16 @@ namespace tessera::test {
 class Child {
  public:
   Child() = default;
-  Child(const std::vector<std::string>& args, const std::string& log) {
+  /// `env`: NAME=value entries added to (or replacing) this process's environment.
+  Child(const std::vector<std::string>& args, const std::string& log, const std::vector<std::string>& env = {}) {
+    std::vector<std::string> environment;
+    for (char** e = environ; *e; ++e) {
+      std::string entry(*e);
+      bool replaced = false;
+      for (const auto& x : env) replaced |= entry.substr(0, entry.find('=') + 1) == x.substr(0, x.find('=') + 1);
+      if (!replaced) environment.push_back(entry);
+    }
+    environment.insert(environment.end(), env.begin(), env.end());
     pid_ = fork();
     if (pid_ == 0) {
       FILE* f = std::fopen(log.c_str(), "a");
@@ -37,7 +46,10 @@ class Child {
       std::vector<char*> argv;
       for (auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
       argv.push_back(nullptr);
-      execv(argv[0], argv.data());
+      std::vector<char*> envp;
+      for (auto& e : environment) envp.push_back(const_cast<char*>(e.c_str()));
+      envp.push_back(nullptr);
+      execve(argv[0], argv.data(), envp.data());
       _exit(127);
     }
   }
@@ -54,6 +66,19 @@ class Child {
       waitpid(pid_, nullptr, 0);
       pid_ = -1;
     }
+  }
+  /// Waits up to `seconds` for the process to exit by itself; its exit status, or -1.
+  int wait_exit(double seconds) {
+    auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    while (pid_ > 0 && std::chrono::steady_clock::now() < end) {
+      int status = 0;
+      if (waitpid(pid_, &status, WNOHANG) == pid_) {
+        pid_ = -1;
+        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return -1;
   }
   /// SIGTERM and wait; returns the exit status (or -1 after `seconds`, then SIGKILL).
   int terminate(double seconds = 20) {
@@ -102,13 +127,20 @@ class Farm {
   }
   void kill_server() { server_.kill_now(); }
   int stop_server() { return server_.terminate(); }
+  /// Tokens the harness's client and workers use (the server's flags set the real ones).
+  void set_tokens(std::string client, std::string worker) {
+    client_token_ = std::move(client);
+    worker_token_ = std::move(worker);
+  }
   Child& add_worker(int threads = 1, std::vector<std::string> extra = {}) {
     const std::string n = std::to_string(workers_.size());
     std::vector<std::string> args = {TESSERA_WORKER_BIN, "--server", url(), "--threads", std::to_string(threads),
                                      "--name", "w" + n, "--cache-dir", (dir_.path / ("cache" + n)).string(),
                                      "--poll-wait", "2"};
     args.insert(args.end(), extra.begin(), extra.end());
-    workers_.emplace_back(args, log("worker" + n));
+    std::vector<std::string> env;
+    if (!worker_token_.empty()) env.push_back("TESSERA_WORKER_TOKEN=" + worker_token_);
+    workers_.emplace_back(args, log("worker" + n), env);
     return workers_.back();
   }
   Child& worker(size_t i) { return workers_[i]; }
@@ -127,7 +159,7 @@ class Farm {
   }
 
   std::string url() const { return "http://127.0.0.1:" + std::to_string(port_); }
-  farm::FarmClient client() const { return farm::FarmClient(url()); }
+  farm::FarmClient client() const { return farm::FarmClient(url(), client_token_); }
   const TempDir& dir() const { return dir_; }
   std::string log(const std::string& name) const { return (dir_.path / (name + ".log")).string(); }
 
@@ -172,6 +204,7 @@ class Farm {
  private:
   TempDir dir_;
   std::vector<std::string> flags_;
+  std::string client_token_, worker_token_;
   int port_ = 0;
   Child server_;
   std::vector<Child> workers_;

@@ -20,8 +20,10 @@ HttpReply reply_of(const httplib::Result& r) {
   return out;
 }
 
-std::unique_ptr<httplib::Client> make_client(const std::string& host, int port, double timeout) {
+std::unique_ptr<httplib::Client> make_client(const std::string& host, int port, double timeout,
+                                             const std::string& token) {
   auto c = std::make_unique<httplib::Client>(host, port);
+  if (!token.empty()) c->set_bearer_token_auth(token);
   const time_t sec = time_t(timeout);
   const time_t usec = time_t((timeout - double(sec)) * 1e6);
   c->set_connection_timeout(5, 0);
@@ -42,14 +44,18 @@ std::string HttpReply::describe() const {
   if (status == 0) return "no answer from the server (" + transport + ")";
   nlohmann::json j = json();
   std::string s = "HTTP " + std::to_string(status);
-  if (j.is_object() && j.contains("error")) {
-    s += " " + j["error"].get<std::string>();
-    if (j.contains("detail") && j["detail"].is_string()) s += ": " + j["detail"].get<std::string>();
+  if (j.is_object() && j.contains("error") && j["error"].is_string()) {
+    s += ' ';
+    s += j["error"].get<std::string>();  // (appends, not "x" + string&&: GCC 12 warns on that falsely)
+    if (j.contains("detail") && j["detail"].is_string()) {
+      s += ": ";
+      s += j["detail"].get<std::string>();
+    }
   }
   return s;
 }
 
-FarmClient::FarmClient(std::string url) : url_(std::move(url)) {
+FarmClient::FarmClient(std::string url, std::string token) : url_(std::move(url)), token_(std::move(token)) {
   while (!url_.empty() && url_.back() == '/') url_.pop_back();
   const std::string scheme = "http://";
   if (url_.rfind(scheme, 0) != 0) return;
@@ -70,20 +76,20 @@ bool FarmClient::valid(std::string* why) const {
 }
 
 HttpReply FarmClient::get(const std::string& path, double timeout) const {
-  return reply_of(make_client(host_, port_, timeout)->Get(path.c_str()));
+  return reply_of(make_client(host_, port_, timeout, token_)->Get(path.c_str()));
 }
 
 HttpReply FarmClient::del(const std::string& path, const json& body, double timeout) const {
-  return reply_of(make_client(host_, port_, timeout)->Delete(path.c_str(), body.dump(), "application/json"));
+  return reply_of(make_client(host_, port_, timeout, token_)->Delete(path.c_str(), body.dump(), "application/json"));
 }
 
 HttpReply FarmClient::post_json(const std::string& path, const json& body, double timeout) const {
-  return reply_of(make_client(host_, port_, timeout)->Post(path.c_str(), body.dump(), "application/json"));
+  return reply_of(make_client(host_, port_, timeout, token_)->Post(path.c_str(), body.dump(), "application/json"));
 }
 
 HttpReply FarmClient::post_bytes(const std::string& path, const std::string& bytes, const std::string& type,
                                  double timeout) const {
-  return reply_of(make_client(host_, port_, timeout)->Post(path.c_str(), bytes, type.c_str()));
+  return reply_of(make_client(host_, port_, timeout, token_)->Post(path.c_str(), bytes, type.c_str()));
 }
 
 HttpReply FarmClient::post_job_with_bundle(const json& settings, const std::string& bundle, double timeout) const {
@@ -91,7 +97,7 @@ HttpReply FarmClient::post_job_with_bundle(const json& settings, const std::stri
       {"settings", settings.dump(), "settings.json", "application/json"},
       {"bundle", bundle, "scene.tar.gz", "application/gzip"},
   };
-  return reply_of(make_client(host_, port_, timeout)->Post("/api/v1/jobs", items));
+  return reply_of(make_client(host_, port_, timeout, token_)->Post("/api/v1/jobs", items));
 }
 
 }  // namespace tessera::farm

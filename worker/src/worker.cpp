@@ -37,7 +37,7 @@ WorkerOptions resolve_worker_options(WorkerOptions o) {
 }
 
 Worker::Worker(WorkerOptions options)
-    : opt_(resolve_worker_options(std::move(options))), client_(opt_.server), cache_(opt_.cache_dir, opt_.memory_budget) {}
+    : opt_(resolve_worker_options(std::move(options))), client_(opt_.server, opt_.token), cache_(opt_.cache_dir, opt_.memory_budget) {}
 
 void Worker::backoff(int& attempt, bool interruptible) {
   // 0.25 s doubling to 8 s, in small steps so a stop request is seen at once.
@@ -60,7 +60,7 @@ bool Worker::register_with_server() {
                    worker_id_.load(), opt_.threads);
       return true;
     }
-    if (r.status == 409 || r.status == 400) {
+    if (r.status == 409 || r.status == 400 || r.status == 401) {
       spdlog::error("the coordinator refused this worker: {}", r.describe());
       refused_ = true;
       stop_ = true;

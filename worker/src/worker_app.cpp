@@ -22,10 +22,18 @@ int worker_main(int argc, char** argv) {
   app.add_option("--memory-budget", budget_mb, "MB of loaded scenes kept in memory (default: half the RAM)");
   app.add_option("--poll-wait", o.poll_wait, "seconds per lease long poll")->check(CLI::Range(0.0, 30.0))->capture_default_str();
   app.add_option("--max-leases", o.max_leases, "exit after this many leases (benchmarks)");
+  std::string token_file;
+  app.add_option("--token-file", token_file, "read the worker token from this file (else $TESSERA_WORKER_TOKEN)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  }
+  try {
+    o.token = resolve_token("", token_file, "TESSERA_WORKER_TOKEN");
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return 2;
   }
   o.memory_budget = uint64_t(budget_mb * 1048576.0);
 

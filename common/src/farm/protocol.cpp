@@ -2,7 +2,10 @@
 
 #include "tessera/farm/sha256.h"
 
+#include <cstdlib>
+#include <fstream>
 #include <set>
+#include <stdexcept>
 
 namespace tessera {
 namespace {
@@ -215,6 +218,20 @@ bool worker_hello_from_json(const json& j, WorkerHello& out, std::string& error)
     return false;
   }
   return true;
+}
+
+std::string resolve_token(const std::string& flag, const std::string& file, const char* env_var) {
+  if (!flag.empty()) return flag;
+  if (!file.empty()) {
+    std::ifstream in(file);
+    std::string line;
+    if (!in || !std::getline(in, line)) throw std::runtime_error("cannot read a token from '" + file + "'");
+    while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
+    if (line.empty()) throw std::runtime_error("the token file '" + file + "' is empty");
+    return line;
+  }
+  const char* env = std::getenv(env_var);
+  return env ? env : "";
 }
 
 std::string scene_cache_key(const JobSettings& s, const std::string& scene_file) {

@@ -32,6 +32,7 @@ struct CompareOptions {
 /// `tessera submit`: the same rendering flags as render, sent to a coordinator.
 struct SubmitOptions {
   std::string scene, server;
+  std::string token_file;            // else $TESSERA_CLIENT_TOKEN
   std::vector<std::string> outputs;  // implies wait
   int spp = 0, width = 0, height = 0, tile_size = 32, priority = 0;
   uint32_t seed = 0;
@@ -42,6 +43,7 @@ struct SubmitOptions {
 
 struct JobsOptions {
   std::string server;
+  std::string token_file;  // else $TESSERA_CLIENT_TOKEN
   uint64_t cancel_id = 0;  // run_cancel
 };
 

@@ -69,6 +69,11 @@ struct WorkerHello {
 nlohmann::json to_json(const WorkerHello& h);
 [[nodiscard]] bool worker_hello_from_json(const nlohmann::json& j, WorkerHello& out, std::string& error);
 
+/// A bearer token from a flag, a file or the environment, in that order of precedence: `flag`,
+/// else the first line of `file`, else $`env_var` (empty when none is set). Throws
+/// std::runtime_error naming an unreadable or empty file.
+std::string resolve_token(const std::string& flag, const std::string& file, const char* env_var);
+
 /// The key under which a worker caches a loaded scene: everything that changes what load_scene
 /// builds (bundle, XML, defines, size, spp, integrator, light selection).
 std::string scene_cache_key(const JobSettings& resolved, const std::string& scene_file);

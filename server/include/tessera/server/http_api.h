@@ -2,6 +2,7 @@
 // Coordinator service and map its Result to a status code and a JSON body.
 #pragma once
 
+#include "tessera/server/auth.h"
 #include "tessera/server/coordinator.h"
 
 namespace httplib {
@@ -10,7 +11,8 @@ class Server;
 
 namespace tessera::server {
 
-/// Installs every /api/v1 route, /healthz, and JSON error and exception handlers.
-void install_routes(httplib::Server& http, Coordinator& coordinator);
+/// Installs every /api/v1 route, /healthz, the bearer-token check (before any body is read) and
+/// JSON error and exception handlers.
+void install_routes(httplib::Server& http, Coordinator& coordinator, const AuthTokens& tokens = {});
 
 }  // namespace tessera::server

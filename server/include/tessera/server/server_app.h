@@ -15,6 +15,7 @@ struct ServerOptions {
   int local_workers = 0;
   int local_worker_threads = 0;           // 0: the machine's cores divided among the local workers
   std::string worker_binary;              // default: tessera-worker beside this program
+  std::string client_token, client_token_file, worker_token, worker_token_file;  // auth.h
   CoordinatorOptions coordinator;
 };
 

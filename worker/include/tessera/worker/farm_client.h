@@ -23,8 +23,8 @@ struct HttpReply {
 
 class FarmClient {
  public:
-  /// `url`: http://HOST:PORT (a trailing slash is fine).
-  explicit FarmClient(std::string url);
+  /// `url`: http://HOST:PORT (a trailing slash is fine); `token`: sent as a bearer token if set.
+  explicit FarmClient(std::string url, std::string token = "");
   const std::string& url() const { return url_; }
   /// False with a message if the URL is not http://HOST[:PORT].
   bool valid(std::string* why = nullptr) const;
@@ -40,7 +40,7 @@ class FarmClient {
                                  double timeout_seconds = 600) const;
 
  private:
-  std::string url_, host_;
+  std::string url_, host_, token_;
   int port_ = 0;
 };
 

@@ -1,0 +1,41 @@
+#include "tessera/server/auth.h"
+
+#include "tessera/farm/sha256.h"
+
+#include <openssl/crypto.h>
+
+
+namespace tessera::server {
+
+Access required_access(const std::string& method, const std::string& path) {
+  if (path == "/healthz") return Access::Open;
+  if (path.rfind("/api/v1/workers", 0) == 0) {
+    // Listing workers is for people (the dashboard, operators); everything else is the protocol.
+    return method == "GET" && path == "/api/v1/workers" ? Access::Client : Access::Worker;
+  }
+  // Workers download bundles; clients may fetch what they uploaded.
+  if (method == "GET" && path.rfind("/api/v1/scenes/", 0) == 0) return Access::ClientOrWorker;
+  if (path.rfind("/api/", 0) == 0) return Access::Client;
+  return Access::Client;  // anything else (unknown paths included) is not for strangers
+}
+
+bool tokens_equal(const std::string& a, const std::string& b) {
+  const Sha256Digest da = sha256(a), db = sha256(b);
+  return CRYPTO_memcmp(da.data(), db.data(), da.size()) == 0;
+}
+
+bool authorized(const AuthTokens& tokens, Access access, const std::string& authorization) {
+  if (access == Access::Open) return true;
+  const std::string prefix = "Bearer ";
+  const std::string given = authorization.rfind(prefix, 0) == 0 ? authorization.substr(prefix.size()) : "";
+  auto accepts = [&](const std::string& token) { return token.empty() || (!given.empty() && tokens_equal(given, token)); };
+  switch (access) {
+    case Access::Client: return accepts(tokens.client);
+    case Access::Worker: return accepts(tokens.worker);
+    case Access::ClientOrWorker: return accepts(tokens.client) || accepts(tokens.worker);
+    case Access::Open: return true;
+  }
+  return false;
+}
+
+}  // namespace tessera::server
