@@ -150,6 +150,7 @@ void Coordinator::Impl::reap_loop() {
       if (it->second.expires < now) {
         spdlog::warn("lease {} (job {}, unit {}) of worker {} expired; re-issuing", it->first, it->second.job,
                      it->second.unit, it->second.worker);
+        ++counters.expired;
         end_lease(it);
       }
       it = next;
@@ -158,6 +159,41 @@ void Coordinator::Impl::reap_loop() {
     for (auto& [id, w] : workers)
       if ((w.state == "idle" || w.state == "busy") && now - w.last_seen > silent) w.state = "lost";
   }
+}
+
+std::string Coordinator::metrics() {
+  Impl& s = *impl_;
+  std::lock_guard<std::mutex> lock(s.mu);
+  std::string out = metric_header("tessera_jobs", "gauge", "Jobs by state.");
+  std::map<std::string, int> jobs;
+  for (JobPhase p : {JobPhase::Queued, JobPhase::Running, JobPhase::Done, JobPhase::Failed, JobPhase::Cancelled})
+    jobs[phase_name(p)] = 0;
+  for (auto& [id, job] : s.jobs) ++jobs[phase_name(job->phase)];
+  for (auto& [state, n] : jobs) out += "tessera_jobs{state=\"" + state + "\"} " + std::to_string(n) + "\n";
+
+  out += metric_header("tessera_passes_total", "counter", "Tile passes leased, done, expired, failed, duplicated since start.");
+  const auto& c = s.counters;
+  for (auto [event, n] : {std::pair{"leased", c.leased}, std::pair{"done", c.done}, std::pair{"expired", c.expired},
+                          std::pair{"failed", c.failed}, std::pair{"duplicate", c.duplicates}})
+    out += std::string("tessera_passes_total{event=\"") + event + "\"} " + std::to_string(n) + "\n";
+  out += metric_header("tessera_leases_active", "gauge", "Leases in flight.");
+  out += "tessera_leases_active " + std::to_string(s.leases.size()) + "\n";
+
+  out += metric_header("tessera_workers", "gauge", "Workers by state.");
+  std::map<std::string, int> workers = {{"idle", 0}, {"busy", 0}, {"lost", 0}, {"gone", 0}};
+  for (auto& [id, w] : s.workers) ++workers[w.state];
+  for (auto& [state, n] : workers) out += "tessera_workers{state=\"" + state + "\"} " + std::to_string(n) + "\n";
+  out += metric_header("tessera_worker_samples_per_second", "gauge", "Pixel samples per second of render time, per worker.");
+  for (auto& [id, w] : s.workers)
+    out += "tessera_worker_samples_per_second{worker=\"" + std::to_string(id) + "\",name=\"" + escape_label(w.row.name) +
+           "\"} " + std::to_string(w.render_seconds > 0 ? double(w.samples_done) / w.render_seconds : 0.0) + "\n";
+
+  out += s.lease_wait.render("tessera_lease_wait_seconds", "Time a lease request waited (long poll) before its answer.");
+  out += s.upload_seconds.render("tessera_upload_seconds", "Time to verify and commit an uploaded tile result.");
+  out += metric_header("tessera_bytes_total", "counter", "Payload bytes received (bundles, results) and sent (leases, bundles, images).");
+  out += "tessera_bytes_total{direction=\"in\"} " + std::to_string(c.bytes_in) + "\n";
+  out += "tessera_bytes_total{direction=\"out\"} " + std::to_string(c.bytes_out) + "\n";
+  return out;
 }
 
 nlohmann::json Coordinator::health() {

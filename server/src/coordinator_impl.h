@@ -3,6 +3,7 @@
 #pragma once
 
 #include "job_state.h"
+#include "metrics.h"
 #include "tessera/farm/build_fingerprint.h"
 #include "tessera/server/coordinator.h"
 #include "tessera/server/store.h"
@@ -48,6 +49,12 @@ struct Coordinator::Impl {
   bool stopping = false;
   std::thread reaper;
   Clock::time_point started = Clock::now();
+  // For /metrics (under `mu`).
+  struct Counters {
+    uint64_t leased = 0, done = 0, expired = 0, failed = 0, duplicates = 0, bytes_in = 0, bytes_out = 0;
+  } counters;
+  Histogram lease_wait{{0.001, 0.01, 0.1, 0.5, 1, 2.5, 5, 10, 20, 30}};
+  Histogram upload_seconds{{0.0005, 0.001, 0.0025, 0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 1}};
 
   std::string bundle_path(const std::string& hash) const;
   std::string scene_dir(const std::string& hash) const;

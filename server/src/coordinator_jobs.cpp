@@ -86,6 +86,7 @@ Result<json> Coordinator::upload_scene(const std::string& bundle) {
     if (!fs::exists(s.bundle_path(hash))) write_file_durably(s.bundle_path(hash), bundle);
     std::lock_guard<std::mutex> lock(s.mu);
     s.store.add_scene(hash, bundle.size(), wall_seconds());
+    s.counters.bytes_in += bundle.size();
   } catch (const std::exception& e) {
     return internal_error(e);
   }
@@ -105,7 +106,10 @@ Result<std::string> Coordinator::scene_bundle(const std::string& hash) {
   Result<std::string> path = scene_bundle_path(hash);
   if (!path.ok()) return path.status;
   try {
-    return read_file(path.value);
+    std::string bytes = read_file(path.value);
+    std::lock_guard<std::mutex> lock(impl_->mu);
+    impl_->counters.bytes_out += bytes.size();
+    return bytes;
   } catch (const std::exception& e) {
     return internal_error(e);
   }
@@ -275,6 +279,8 @@ Result<ImageBytes> Coordinator::job_image(uint64_t id, const std::string& format
     }
     ImageBytes out{read_file(tmp), format == "png" ? "image/png" : format == "exr" ? "image/x-exr" : "image/x-pfm"};
     fs::remove(tmp);
+    std::lock_guard<std::mutex> lock(s.mu);
+    s.counters.bytes_out += out.bytes.size();
     return out;
   } catch (const std::exception& e) {
     std::error_code ec;

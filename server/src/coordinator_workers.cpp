@@ -66,6 +66,7 @@ Result<json> Coordinator::lease(uint64_t worker, double wait_seconds) {
     ~PollSlot() { --n; }
   } slot{s.waiting_polls};
   if (s.waiting_polls.fetch_add(1) >= s.opt.max_waiting_polls || !(wait_seconds >= 0)) wait_seconds = 0;  // NaN too
+  const auto t0 = Clock::now();
   std::unique_lock<std::mutex> lock(s.mu);
   WorkerInfo* w = s.find_worker(worker);
   if (!w) return unknown_worker(worker);
@@ -113,7 +114,11 @@ Result<json> Coordinator::lease(uint64_t worker, double wait_seconds) {
         }
         w->state = "busy";
         json j = to_json(l);
-        best->lease_bytes += j.dump().size();
+        const size_t bytes = j.dump().size();
+        best->lease_bytes += bytes;
+        s.counters.bytes_out += bytes;
+        ++s.counters.leased;
+        s.lease_wait.observe(std::chrono::duration<double>(Clock::now() - t0).count());
         return j;
       } catch (const std::exception& e) {
         return internal_error(e);
@@ -127,6 +132,7 @@ Result<json> Coordinator::lease(uint64_t worker, double wait_seconds) {
     for (auto& [id, l] : s.leases) holds |= l.worker == worker;
     if (!holds) w->state = "idle";
   }
+  s.lease_wait.observe(std::chrono::duration<double>(Clock::now() - t0).count());
   return json();
 }
 
@@ -182,6 +188,7 @@ Result<json> Coordinator::heartbeat(uint64_t worker, const json& body) {
 
 Result<json> Coordinator::upload_result(uint64_t worker, uint64_t lease, std::string_view bytes) {
   Impl& s = *impl_;
+  const auto t0 = Clock::now();
   TileResult result;
   std::string error;
   if (!decode_tile_result(bytes, result, error, s.opt.limits.max_pixels))
@@ -208,6 +215,7 @@ Result<json> Coordinator::upload_result(uint64_t worker, uint64_t lease, std::st
   }
   if (job.is_done(unit)) {
     ++job.duplicates;
+    ++s.counters.duplicates;
     return json{{"accepted", false}, {"duplicate", true}};
   }
   try {
@@ -222,6 +230,8 @@ Result<json> Coordinator::upload_result(uint64_t worker, uint64_t lease, std::st
   const uint64_t samples = job.unit_samples(unit);
   (void)job.add_result(unit, std::move(result.film), worker);
   job.result_bytes += bytes.size();
+  ++s.counters.done;
+  s.counters.bytes_in += bytes.size();
   w->units_done += 1;
   w->samples_done += samples;
   w->render_seconds += result.seconds;
@@ -236,6 +246,7 @@ Result<json> Coordinator::upload_result(uint64_t worker, uint64_t lease, std::st
     spdlog::info("job {} done in {:.2f} s", job.id(), job.finished - job.started);
   }
   (void)lease;
+  s.upload_seconds.observe(std::chrono::duration<double>(Clock::now() - t0).count());
   return json{{"accepted", true}, {"duplicate", false}};
 }
 
@@ -254,6 +265,7 @@ Status Coordinator::fail_lease(uint64_t worker, uint64_t lease, const json& body
                            ? body["error"].get<std::string>().substr(0, 2000)
                            : "unspecified";
   ++job.failures_by_worker[worker];
+  ++s.counters.failed;
   job.last_failure = reason;
   spdlog::warn("job {}: worker {} failed a pass: {}", job.id(), worker, reason);
   // The job fails when its work fails on several workers (or on every worker there is).

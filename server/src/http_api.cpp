@@ -86,6 +86,10 @@ void install_routes(httplib::Server& http, Coordinator& c, const AuthTokens& tok
 
   http.Get("/healthz", [&c](const httplib::Request&, httplib::Response& res) { send_json(res, 200, c.health()); });
 
+  http.Get("/metrics", [&c](const httplib::Request&, httplib::Response& res) {
+    res.set_content(c.metrics(), "text/plain; version=0.0.4");
+  });
+
   http.Post("/api/v1/scenes", [&c](const httplib::Request& req, httplib::Response& res) {
     std::string bundle = bundle_of(req);
     if (bundle.empty())

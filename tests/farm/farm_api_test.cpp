@@ -6,6 +6,8 @@
 #include "tessera/farm/tile_result.h"
 
 #include <atomic>
+#include <map>
+#include <sstream>
 
 namespace tessera::test {
 namespace {
@@ -180,6 +182,51 @@ TEST_F(FarmApi, WorkerProtocolRefusesBadBuildsAndBadResults) {
   st = farm_.status(id);
   EXPECT_EQ(st["state"], "failed");
   EXPECT_NE(st.value("error", "").find("out of memory on purpose"), std::string::npos) << st.dump(2);
+}
+
+// /metrics in Prometheus text format, consistent with the job it watched.
+TEST(FarmServing, MetricsAgreeWithTheJob) {
+  TESSERA_REQUIRE_FILE(cornell());
+  Farm farm;
+  farm.start_server();
+  farm.add_worker();
+  ASSERT_TRUE(farm.wait_workers(1));
+  JobSettings s;
+  s.spp = 5;
+  s.width = 48;
+  s.height = 32;
+  s.tile_size = 16;
+  uint64_t id = farm.submit(cornell(), s);
+  json st = farm.wait_job(id);
+  ASSERT_EQ(st["state"], "done");
+  farm::HttpReply r = farm.client().get("/metrics");
+  ASSERT_EQ(r.status, 200);
+  std::map<std::string, double> values;
+  std::istringstream in(r.body);
+  int samples = 0;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    // name{labels} value: every sample line must parse.
+    size_t space = line.rfind(' ');
+    ASSERT_NE(space, std::string::npos) << line;
+    std::string key = line.substr(0, space);
+    ASSERT_TRUE(std::isalpha(static_cast<unsigned char>(key[0]))) << line;
+    values[key] = std::stod(line.substr(space + 1));
+    ++samples;
+  }
+  const double units = st["units_total"].get<double>();
+  EXPECT_EQ(values["tessera_jobs{state=\"done\"}"], 1);
+  EXPECT_EQ(values["tessera_jobs{state=\"running\"}"], 0);
+  EXPECT_EQ(values["tessera_passes_total{event=\"done\"}"], units);
+  EXPECT_EQ(values["tessera_passes_total{event=\"leased\"}"], units);
+  EXPECT_EQ(values["tessera_upload_seconds_count"], units);
+  EXPECT_EQ(values["tessera_upload_seconds_bucket{le=\"+Inf\"}"], units);
+  EXPECT_GE(values["tessera_lease_wait_seconds_count"], units);
+  EXPECT_EQ(values["tessera_workers{state=\"idle\"}"] + values["tessera_workers{state=\"busy\"}"], 1);
+  EXPECT_GE(values["tessera_bytes_total{direction=\"in\"}"], st["result_bytes"].get<double>());
+  EXPECT_GT(values["tessera_bytes_total{direction=\"out\"}"], 0);
+  EXPECT_GT(values["tessera_worker_samples_per_second{worker=\"1\",name=\"w0\"}"], 0);
+  std::printf("%d samples in /metrics\n", samples);
 }
 
 TEST(FarmServing, WaitingWorkersNeverStarveClients) {

@@ -37,7 +37,7 @@ TEST(FarmAuth, EveryCallNeedsTheRightToken) {
       {"POST", "/api/v1/workers", true},        {"POST", "/api/v1/workers/1/lease?wait=0", true},
       {"POST", "/api/v1/workers/1/heartbeat", true}, {"POST", "/api/v1/workers/1/results", true},
       {"POST", "/api/v1/workers/1/leases/1/fail", true}, {"DELETE", "/api/v1/workers/1", true},
-      {"GET", "/api/v1/scenes/" + hash, true},
+      {"GET", "/api/v1/scenes/" + hash, true},        {"GET", "/metrics", false},
   };
   const farm::FarmClient none(farm.url()), wrong(farm.url(), "guess"), client(farm.url(), kClient),
       worker(farm.url(), kWorker);

@@ -74,6 +74,9 @@ class Coordinator {
   Result<nlohmann::json> list_workers();
 
   nlohmann::json health();
+  /// Prometheus text format: jobs and workers by state, passes leased/done/expired/failed,
+  /// lease-wait and upload latency histograms, bytes in and out, per-worker samples/s.
+  std::string metrics();
   /// Wakes every long poll and refuses new ones (503); called on SIGTERM.
   void shutdown();
 
