@@ -9,6 +9,11 @@ namespace tessera::server {
 
 Access required_access(const std::string& method, const std::string& path) {
   if (path == "/healthz") return Access::Open;
+  // Draining a worker is an operator's action.
+  const std::string drain = "/drain";
+  if (path.rfind("/api/v1/workers/", 0) == 0 && path.size() > drain.size() &&
+      path.compare(path.size() - drain.size(), drain.size(), drain) == 0)
+    return Access::Client;
   if (path.rfind("/api/v1/workers", 0) == 0) {
     // Listing workers is for people (the dashboard, operators); everything else is the protocol.
     return method == "GET" && path == "/api/v1/workers" ? Access::Client : Access::Worker;

@@ -64,18 +64,19 @@ Coordinator::Coordinator(CoordinatorOptions options) : impl_(std::make_unique<Im
   // previous process, so their units are simply available again.
   size_t resumed = 0, passes = 0;
   for (JobRow& row : s.store.jobs()) {
-    JobPlan plan;
-    std::string error;
-    if (!job_plan_from_json(nlohmann::json::parse(row.plan_json), plan, error))
-      throw std::runtime_error("job " + std::to_string(row.id) + " in the state database: " + error);
-    auto job = std::make_unique<JobState>(row.id, std::move(plan), row.name, row.priority, row.created);
-    if (!parse_phase(row.state, job->phase)) job->phase = JobPhase::Failed;
-    job->error = row.error;
-    job->started = row.started;
-    job->finished = row.finished;
+    JobPhase phase;
+    if (!parse_phase(row.state, phase)) phase = JobPhase::Failed;
     // A job that ended has its image on disk: only its bookkeeping is rebuilt, not its film.
-    const bool from_image = is_terminal(job->phase) && fs::exists(s.image_path(row.id));
-    if (from_image) {
+    if (is_terminal(phase) && fs::exists(s.image_path(row.id))) {
+      JobPlan plan;
+      std::string error;
+      if (!job_plan_from_json(nlohmann::json::parse(row.plan_json), plan, error))
+        throw std::runtime_error("job " + std::to_string(row.id) + " in the state database: " + error);
+      auto job = std::make_unique<JobState>(row.id, std::move(plan), row.name, row.priority, row.created);
+      job->phase = phase;
+      job->error = row.error;
+      job->started = row.started;
+      job->finished = row.finished;
       s.store.for_each_result(row.id, [&](ResultRow&& r) {
         if (r.tile < job->num_tiles() && r.pass < job->num_passes()) job->mark_done(job->unit(r.tile, r.pass), r.worker);
       }, /*with_data=*/false);
@@ -83,16 +84,8 @@ Coordinator::Coordinator(CoordinatorOptions options) : impl_(std::make_unique<Im
       s.jobs.emplace(row.id, std::move(job));
       continue;
     }
-    s.store.for_each_result(row.id, [&](ResultRow&& r) {
-      TileResult result;
-      std::string err;
-      if (!decode_tile_result(r.data, result, err))
-        throw std::runtime_error("job " + std::to_string(row.id) + ": stored result is corrupt: " + err);
-      if (r.tile < job->num_tiles() && r.pass < job->num_passes()) {
-        (void)job->add_result(job->unit(r.tile, r.pass), std::move(result.film), r.worker);
-        ++passes;
-      }
-    });
+    auto job = s.rebuild_job(row);
+    passes += job->done_units();
     if (!is_terminal(job->phase)) ++resumed;
     else s.save_phase(*job);  // ended before its image was written
     s.jobs.emplace(row.id, std::move(job));
@@ -121,6 +114,27 @@ void Coordinator::Impl::end_lease(std::map<uint64_t, LeaseInfo>::iterator it) {
   if (job != jobs.end()) job->second->lease_ended(it->second.unit);
   leases.erase(it);
   work_cv.notify_all();
+}
+
+std::unique_ptr<JobState> Coordinator::Impl::rebuild_job(const JobRow& row) {
+  JobPlan plan;
+  std::string error;
+  if (!job_plan_from_json(nlohmann::json::parse(row.plan_json), plan, error))
+    throw std::runtime_error("job " + std::to_string(row.id) + " in the state database: " + error);
+  auto job = std::make_unique<JobState>(row.id, std::move(plan), row.name, row.priority, row.created);
+  if (!parse_phase(row.state, job->phase)) job->phase = JobPhase::Failed;
+  job->error = row.error;
+  job->started = row.started;
+  job->finished = row.finished;
+  store.for_each_result(row.id, [&](ResultRow&& r) {
+    TileResult result;
+    std::string err;
+    if (!decode_tile_result(r.data, result, err))
+      throw std::runtime_error("job " + std::to_string(row.id) + ": stored result is corrupt: " + err);
+    if (r.tile < job->num_tiles() && r.pass < job->num_passes())
+      (void)job->add_result(job->unit(r.tile, r.pass), std::move(result.film), r.worker);
+  });
+  return job;
 }
 
 std::string Coordinator::Impl::image_path(uint64_t job) const {
@@ -180,7 +194,7 @@ std::string Coordinator::metrics() {
   out += "tessera_leases_active " + std::to_string(s.leases.size()) + "\n";
 
   out += metric_header("tessera_workers", "gauge", "Workers by state.");
-  std::map<std::string, int> workers = {{"idle", 0}, {"busy", 0}, {"lost", 0}, {"gone", 0}};
+  std::map<std::string, int> workers = {{"idle", 0}, {"busy", 0}, {"draining", 0}, {"lost", 0}, {"gone", 0}};
   for (auto& [id, w] : s.workers) ++workers[w.state];
   for (auto& [state, n] : workers) out += "tessera_workers{state=\"" + state + "\"} " + std::to_string(n) + "\n";
   out += metric_header("tessera_worker_samples_per_second", "gauge", "Pixel samples per second of render time, per worker.");

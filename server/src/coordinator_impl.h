@@ -65,6 +65,8 @@ struct Coordinator::Impl {
   /// Under `mu`: persists a job's phase; a job that ended writes its image and drops its film.
   void save_phase(JobState& job);
   std::string image_path(uint64_t job) const;
+  /// A job rebuilt from its row's plan and every stored result (its film included).
+  std::unique_ptr<JobState> rebuild_job(const JobRow& row);
   /// Under `mu`: job status as JSON.
   nlohmann::json status_json(const JobState& job);
   /// Expires leases and marks silent workers lost, once a second.

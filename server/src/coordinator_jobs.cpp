@@ -313,4 +313,43 @@ Status Coordinator::cancel_job(uint64_t id) {
   return Status::success();
 }
 
+Status Coordinator::set_priority(uint64_t id, int priority) {
+  Impl& s = *impl_;
+  std::lock_guard<std::mutex> lock(s.mu);
+  auto it = s.jobs.find(id);
+  if (it == s.jobs.end()) return make_error(Code::NotFound, "unknown_job", "no job " + std::to_string(id));
+  try {
+    s.store.set_job_priority(id, priority);
+  } catch (const std::exception& e) {
+    return internal_error(e);
+  }
+  it->second->set_priority(priority);
+  spdlog::info("job {}: priority {}", id, priority);
+  s.work_cv.notify_all();
+  return Status::success();
+}
+
+Status Coordinator::retry_job(uint64_t id) {
+  Impl& s = *impl_;
+  std::lock_guard<std::mutex> lock(s.mu);
+  auto it = s.jobs.find(id);
+  if (it == s.jobs.end()) return make_error(Code::NotFound, "unknown_job", "no job " + std::to_string(id));
+  JobState& old = *it->second;
+  if (old.phase != JobPhase::Failed && old.phase != JobPhase::Cancelled)
+    return make_error(Code::Conflict, "job_not_ended",
+                      "job " + std::to_string(id) + " is " + phase_name(old.phase) + "; only failed or cancelled jobs are retried");
+  try {
+    // The passes it has stay: the job is rebuilt from its stored results, film included.
+    JobRow row{id, old.name(), to_json(old.plan()).dump(), "queued", "", old.priority(), old.created(), old.started, 0};
+    auto job = s.rebuild_job(row);
+    s.save_phase(*job);
+    spdlog::info("job {} queued again with {} of {} passes done", id, job->done_units(), job->num_units());
+    it->second = std::move(job);
+  } catch (const std::exception& e) {
+    return internal_error(e);
+  }
+  s.work_cv.notify_all();
+  return Status::success();
+}
+
 }  // namespace tessera::server

@@ -71,10 +71,14 @@ Result<json> Coordinator::lease(uint64_t worker, double wait_seconds) {
   WorkerInfo* w = s.find_worker(worker);
   if (!w) return unknown_worker(worker);
   w->last_seen = Clock::now();
+  if (w->state == "draining")
+    return make_error(Code::Gone, "drained", "worker " + std::to_string(worker) + " is being drained: no more work");
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
                                            std::clamp(wait_seconds, 0.0, s.opt.max_poll_wait)));
   for (;;) {
     if (s.stopping) return make_error(Code::Unavailable, "stopping", "the coordinator is shutting down");
+    if (w->state == "draining")
+      return make_error(Code::Gone, "drained", "worker " + std::to_string(worker) + " is being drained: no more work");
     JobState* best = nullptr;
     size_t unit = 0;
     for (auto& [id, job] : s.jobs) {
@@ -127,7 +131,7 @@ Result<json> Coordinator::lease(uint64_t worker, double wait_seconds) {
     if (Clock::now() >= deadline) break;
     s.work_cv.wait_until(lock, deadline);
   }
-  if (w->state == "busy") {
+  if (w->state == "busy") {  // (a draining worker keeps its state)
     bool holds = false;
     for (auto& [id, l] : s.leases) holds |= l.worker == worker;
     if (!holds) w->state = "idle";
@@ -308,6 +312,18 @@ Status Coordinator::sign_off(uint64_t worker, const json& body) {
     return internal_error(e);
   }
   spdlog::info("worker {} signed off", worker);
+  return Status::success();
+}
+
+Status Coordinator::drain_worker(uint64_t worker) {
+  Impl& s = *impl_;
+  std::lock_guard<std::mutex> lock(s.mu);
+  WorkerInfo* w = s.find_worker(worker);
+  if (!w) return unknown_worker(worker);
+  if (w->state == "gone") return make_error(Code::Conflict, "worker_gone", "worker " + std::to_string(worker) + " signed off");
+  w->state = "draining";
+  s.work_cv.notify_all();  // its waiting polls return now
+  spdlog::info("worker {} draining", worker);
   return Status::success();
 }
 

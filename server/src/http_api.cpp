@@ -133,6 +133,23 @@ void install_routes(httplib::Server& http, Coordinator& c, const AuthTokens& tok
     if (parse_id(req, 1, id, res)) send(res, c.cancel_job(id));
   });
 
+  http.Patch(R"(/api/v1/jobs/(\d+))", [&c](const httplib::Request& req, httplib::Response& res) {
+    uint64_t id;
+    json body;
+    if (!parse_id(req, 1, id, res) || !parse_body(req, res, body)) return;
+    if (!body.is_object() || body.size() != 1 || !body.contains("priority") || !body["priority"].is_number_integer())
+      return send_error(res, make_error(Code::BadRequest, "bad_request", "send {\"priority\": N}"));
+    send(res, c.set_priority(id, body["priority"].get<int>()));
+  });
+  http.Post(R"(/api/v1/jobs/(\d+)/retry)", [&c](const httplib::Request& req, httplib::Response& res) {
+    uint64_t id;
+    if (parse_id(req, 1, id, res)) send(res, c.retry_job(id));
+  });
+
+  http.Post(R"(/api/v1/workers/(\d+)/drain)", [&c](const httplib::Request& req, httplib::Response& res) {
+    uint64_t id;
+    if (parse_id(req, 1, id, res)) send(res, c.drain_worker(id));
+  });
   http.Post("/api/v1/workers", [&c](const httplib::Request& req, httplib::Response& res) {
     json body;
     if (parse_body(req, res, body)) send(res, c.register_worker(body), 201);

@@ -69,6 +69,8 @@ class JobState {
   const RenderCounters& counters() const { return counters_; }
   const std::map<uint64_t, uint64_t>& samples_by_worker() const { return samples_by_worker_; }
 
+  void set_priority(int p) { priority_ = p; }
+
   JobPhase phase = JobPhase::Queued;
   std::string error;
   double started = 0, finished = 0;

@@ -123,6 +123,11 @@ void Store::set_job_state(uint64_t id, const std::string& state, const std::stri
   st.bind(state).bind(error).bind(started).bind(finished).bind(int64_t(id)).step();
 }
 
+void Store::set_job_priority(uint64_t id, int priority) {
+  Stmt st(db_, "UPDATE jobs SET priority = ? WHERE id = ?");
+  st.bind(int64_t(priority)).bind(int64_t(id)).step();
+}
+
 std::vector<JobRow> Store::jobs() {
   Stmt st(db_, "SELECT id, name, plan, priority, state, error, created, started, finished FROM jobs ORDER BY id");
   std::vector<JobRow> rows;

@@ -161,6 +161,58 @@ TEST(Coordinator, FinishedJobIsServedFromItsImageAfterARestart) {
   EXPECT_FALSE(exr_before.empty());
 }
 
+TEST(Coordinator, PriorityCanChangeWhileJobsWait) {
+  TempDir dir;
+  Coordinator c(options(dir));
+  const uint64_t w = add_worker(c, "w");
+  const uint64_t a = c.submit_job(json{{"tile_size", 8}, {"name", "a"}}, bundle()).value["id"];
+  const uint64_t b = c.submit_job(json{{"tile_size", 8}, {"name", "b"}}, bundle()).value["id"];
+  EXPECT_EQ(c.lease(w, 0).value["job"], a) << "equal priorities: the older job first";
+  EXPECT_TRUE(c.set_priority(b, 5).ok());
+  EXPECT_EQ(c.lease(w, 0).value["job"], b);
+  EXPECT_EQ(c.job_status(b).value["priority"], 5);
+  EXPECT_EQ(c.set_priority(99, 1).code, server::Code::NotFound);
+}
+
+TEST(Coordinator, RetriedJobKeepsItsPassesAndFinishesBitIdentical) {
+  TempDir dir, src;
+  LoadResult loaded = load_scene(parse_scene_file(src.write("scene.xml", kXml)), LoadOptions{});
+  Coordinator c(options(dir));
+  const uint64_t w = add_worker(c, "w");
+  const uint64_t id = c.submit_job(json{{"tile_size", 8}, {"seed", 3}}, bundle()).value["id"];
+  ASSERT_TRUE(deliver_one(c, w, *loaded.scene, 3));
+  ASSERT_TRUE(deliver_one(c, w, *loaded.scene, 3));
+  EXPECT_EQ(c.retry_job(id).code, server::Code::Conflict) << "a running job is not retried";
+  json l = c.lease(w, 0).value;
+  ASSERT_TRUE(c.fail_lease(w, l["id"], json{{"error", "disk full"}}).ok());
+  ASSERT_EQ(c.job_status(id).value["state"], "failed");
+  ASSERT_TRUE(c.retry_job(id).ok());
+  json st = c.job_status(id).value;
+  EXPECT_EQ(st["state"], "queued");
+  EXPECT_EQ(st["units_done"], 2);
+  EXPECT_EQ(st["error"], "");
+  while (deliver_one(c, w, *loaded.scene, 3)) {
+  }
+  ASSERT_EQ(c.job_status(id).value["state"], "done");
+  // The same image as a job that never failed.
+  const uint64_t clean = c.submit_job(json{{"tile_size", 8}, {"seed", 3}}, bundle()).value["id"];
+  while (deliver_one(c, w, *loaded.scene, 3)) {
+  }
+  EXPECT_EQ(c.job_image(id, "pfm").value.bytes, c.job_image(clean, "pfm").value.bytes);
+}
+
+TEST(Coordinator, DrainedWorkerGetsNoMoreWork) {
+  TempDir dir;
+  Coordinator c(options(dir));
+  const uint64_t a = add_worker(c, "a"), b = add_worker(c, "b");
+  ASSERT_TRUE(c.submit_job(json{{"tile_size", 8}}, bundle()).ok());
+  ASSERT_TRUE(c.drain_worker(a).ok());
+  EXPECT_EQ(c.lease(a, 0).status.code, server::Code::Gone);
+  EXPECT_TRUE(c.lease(b, 0).value.is_object());
+  EXPECT_NE(c.metrics().find("tessera_workers{state=\"draining\"} 1"), std::string::npos);
+  EXPECT_EQ(c.drain_worker(77).code, server::Code::NotFound);
+}
+
 TEST(Coordinator, ABrokenDataDirectoryIsAClearError) {
   TempDir dir;
   std::filesystem::create_directories(dir.path / "data");

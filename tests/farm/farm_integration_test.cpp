@@ -182,6 +182,18 @@ TEST(FarmIntegration, WorkerStopsCleanlyOnSigterm) {
   EXPECT_EQ(farm.wait_job(id).value("state", ""), "done");
 }
 
+TEST(FarmIntegration, DrainedWorkerSignsOffAndExits) {
+  Farm farm;
+  farm.start_server();
+  farm.add_worker();
+  ASSERT_TRUE(farm.wait_workers(1));
+  farm::HttpReply r = farm.client().post_json("/api/v1/workers/1/drain", nlohmann::json::object());
+  ASSERT_EQ(r.status, 200) << r.describe();
+  EXPECT_EQ(farm.worker(0).wait_exit(20), 0);
+  nlohmann::json workers = farm.client().get("/api/v1/workers").json();
+  EXPECT_EQ(workers["workers"][0]["state"], "gone");
+}
+
 TEST(FarmIntegration, HeartbeatsKeepLongTilesLeased) {
   TESSERA_REQUIRE_FILE(cornell());
   // One 128x96 tile; its 64-sample pass takes seconds on one thread, longer than the 1.5 s lease

@@ -135,6 +135,11 @@ void Worker::slot_loop(int slot) {
       if (worker_id_ == id) register_with_server();
       continue;
     }
+    if (r.status == 410) {  // drained by an operator: finish, sign off, exit
+      spdlog::info("slot {}: the coordinator drains this worker: {}", slot, r.describe());
+      stop_ = true;
+      break;
+    }
     if (r.status == 204) {
       attempt = 0;
       // Answered at once (the coordinator's long-poll slots are full): wait as told.

@@ -60,6 +60,10 @@ class Coordinator {
   /// format: exr, png or pfm. The partial image while running.
   Result<ImageBytes> job_image(uint64_t id, const std::string& format);
   Status cancel_job(uint64_t id);
+  /// Operating a job: a new priority (any time), or a failed/cancelled job queued again with the
+  /// passes it already has (its failure counts cleared).
+  Status set_priority(uint64_t id, int priority);
+  Status retry_job(uint64_t id);
 
   // Workers.
   Result<nlohmann::json> register_worker(const nlohmann::json& hello);
@@ -71,6 +75,9 @@ class Coordinator {
   Result<nlohmann::json> upload_result(uint64_t worker, uint64_t lease, std::string_view bytes);
   Status fail_lease(uint64_t worker, uint64_t lease, const nlohmann::json& body);
   Status sign_off(uint64_t worker, const nlohmann::json& body);
+  /// Draining: the worker finishes what it renders and gets no more work (its lease polls are
+  /// answered 410, on which tessera-worker signs off and exits).
+  Status drain_worker(uint64_t worker);
   Result<nlohmann::json> list_workers();
 
   nlohmann::json health();

@@ -56,6 +56,7 @@ class Store {
   uint64_t add_job(const std::string& name, const std::string& plan_json, int priority, double now);
   void set_job_state(uint64_t id, const std::string& state, const std::string& error, double started,
                      double finished);
+  void set_job_priority(uint64_t id, int priority);
   std::vector<JobRow> jobs();
 
   /// Logs a lease; returns its sequence number.
