@@ -68,15 +68,7 @@ Coordinator::Coordinator(CoordinatorOptions options) : impl_(std::make_unique<Im
     if (!parse_phase(row.state, phase)) phase = JobPhase::Failed;
     // A job that ended has its image on disk: only its bookkeeping is rebuilt, not its film.
     if (is_terminal(phase) && fs::exists(s.image_path(row.id))) {
-      JobPlan plan;
-      std::string error;
-      if (!job_plan_from_json(nlohmann::json::parse(row.plan_json), plan, error))
-        throw std::runtime_error("job " + std::to_string(row.id) + " in the state database: " + error);
-      auto job = std::make_unique<JobState>(row.id, std::move(plan), row.name, row.priority, row.created);
-      job->phase = phase;
-      job->error = row.error;
-      job->started = row.started;
-      job->finished = row.finished;
+      auto job = s.job_from_row(row);
       s.store.for_each_result(row.id, [&](ResultRow&& r) {
         if (r.tile < job->num_tiles() && r.pass < job->num_passes()) job->mark_done(job->unit(r.tile, r.pass), r.worker);
       }, /*with_data=*/false);
@@ -101,8 +93,6 @@ Coordinator::~Coordinator() {
   if (impl_->reaper.joinable()) impl_->reaper.join();
 }
 
-const CoordinatorOptions& Coordinator::options() const { return impl_->opt; }
-
 void Coordinator::shutdown() {
   std::lock_guard<std::mutex> lock(impl_->mu);
   impl_->stopping = true;
@@ -116,7 +106,7 @@ void Coordinator::Impl::end_lease(std::map<uint64_t, LeaseInfo>::iterator it) {
   work_cv.notify_all();
 }
 
-std::unique_ptr<JobState> Coordinator::Impl::rebuild_job(const JobRow& row) {
+std::unique_ptr<JobState> Coordinator::Impl::job_from_row(const JobRow& row) const {
   JobPlan plan;
   std::string error;
   if (!job_plan_from_json(nlohmann::json::parse(row.plan_json), plan, error))
@@ -126,6 +116,11 @@ std::unique_ptr<JobState> Coordinator::Impl::rebuild_job(const JobRow& row) {
   job->error = row.error;
   job->started = row.started;
   job->finished = row.finished;
+  return job;
+}
+
+std::unique_ptr<JobState> Coordinator::Impl::rebuild_job(const JobRow& row) {
+  auto job = job_from_row(row);
   store.for_each_result(row.id, [&](ResultRow&& r) {
     TileResult result;
     std::string err;

@@ -65,7 +65,9 @@ struct Coordinator::Impl {
   /// Under `mu`: persists a job's phase; a job that ended writes its image and drops its film.
   void save_phase(JobState& job);
   std::string image_path(uint64_t job) const;
-  /// A job rebuilt from its row's plan and every stored result (its film included).
+  /// A job from its row (plan, phase, times), with no results yet.
+  std::unique_ptr<JobState> job_from_row(const JobRow& row) const;
+  /// A job rebuilt from its row and every stored result (its film included).
   std::unique_ptr<JobState> rebuild_job(const JobRow& row);
   /// Under `mu`: job status as JSON.
   nlohmann::json status_json(const JobState& job);
@@ -75,5 +77,8 @@ struct Coordinator::Impl {
 
 double wall_seconds();
 Status internal_error(const std::exception& e);
+inline Status unknown_job(uint64_t id) {
+  return make_error(Code::NotFound, "unknown_job", "no job " + std::to_string(id));
+}
 
 }  // namespace tessera::server

@@ -136,10 +136,15 @@ Result<json> Coordinator::submit_job(const json& body, const std::string& bundle
     std::vector<BundleEntry> entries;
     {
       std::lock_guard<std::mutex> lock(unpack_mutex);
-      BundleResult unpacked = fs::exists(dir) ? inspect_bundle(read_file(path.value), s.opt.bundle_limits)
-                                              : unpack_bundle(read_file(path.value), dir, s.opt.bundle_limits);
-      if (!unpacked.ok()) return make_error(Code::BadRequest, "bad_bundle", unpacked.error);
-      entries = std::move(unpacked.files);
+      if (fs::exists(dir)) {
+        // Unpacked (and checked) by an earlier submission: list it instead of reading the bundle again.
+        for (const auto& e : fs::recursive_directory_iterator(dir))
+          if (e.is_regular_file()) entries.push_back({e.path().lexically_relative(dir).generic_string(), e.file_size()});
+      } else {
+        BundleResult unpacked = unpack_bundle(read_file(path.value), dir, s.opt.bundle_limits);
+        if (!unpacked.ok()) return make_error(Code::BadRequest, "bad_bundle", unpacked.error);
+        entries = std::move(unpacked.files);
+      }
     }
     std::string scene_file = find_scene_xml(entries, settings.scene_file, error);
     if (scene_file.empty()) return make_error(Code::Unprocessable, "no_scene_file", error);
@@ -176,7 +181,7 @@ json Coordinator::Impl::status_json(const JobState& job) {
   const double now = wall_seconds();
   const double end = job.finished > 0 ? job.finished : now;
   const double elapsed = job.started > 0 ? end - job.started : 0;
-  const double fraction = job.total_samples() ? double(job.done_samples()) / double(job.total_samples()) : 1;
+  const double fraction = job.total_samples() ? double(job.done_samples()) / double(job.total_samples()) : 1.0;
   json workers_json = json::array();
   for (auto& [wid, samples] : job.samples_by_worker()) {
     auto w = workers.find(wid);
@@ -222,18 +227,25 @@ json Coordinator::Impl::status_json(const JobState& job) {
 Result<json> Coordinator::job_status(uint64_t id) {
   std::lock_guard<std::mutex> lock(impl_->mu);
   auto it = impl_->jobs.find(id);
-  if (it == impl_->jobs.end()) return make_error(Code::NotFound, "unknown_job", "no job " + std::to_string(id));
+  if (it == impl_->jobs.end()) return unknown_job(id);
   return impl_->status_json(*it->second);
 }
 
 Result<json> Coordinator::list_jobs() {
   std::lock_guard<std::mutex> lock(impl_->mu);
   json list = json::array();
+  // A summary per job, straight from memory (status_json also queries the lease log).
   for (auto& [id, job] : impl_->jobs) {
-    json j = impl_->status_json(*job);
-    list.push_back({{"id", id}, {"name", j["name"]}, {"state", j["state"]}, {"priority", j["priority"]},
-                    {"progress", j["progress"]}, {"width", j["width"]}, {"height", j["height"]}, {"spp", j["spp"]},
-                    {"error", j["error"]}});
+    const JobPlan& p = job->plan();
+    list.push_back({{"id", id},
+                    {"name", job->name()},
+                    {"state", phase_name(job->phase)},
+                    {"priority", job->priority()},
+                    {"progress", job->total_samples() ? double(job->done_samples()) / double(job->total_samples()) : 1.0},
+                    {"width", p.window.width()},
+                    {"height", p.window.height()},
+                    {"spp", p.settings.spp},
+                    {"error", job->error}});
   }
   return json{{"jobs", list}};
 }
@@ -247,7 +259,7 @@ Result<ImageBytes> Coordinator::job_image(uint64_t id, const std::string& format
   {
     std::lock_guard<std::mutex> lock(s.mu);
     auto it = s.jobs.find(id);
-    if (it == s.jobs.end()) return make_error(Code::NotFound, "unknown_job", "no job " + std::to_string(id));
+    if (it == s.jobs.end()) return unknown_job(id);
     plan = it->second->plan();
     if (it->second->has_film()) image = it->second->image();
   }
@@ -293,7 +305,7 @@ Status Coordinator::cancel_job(uint64_t id) {
   Impl& s = *impl_;
   std::lock_guard<std::mutex> lock(s.mu);
   auto it = s.jobs.find(id);
-  if (it == s.jobs.end()) return make_error(Code::NotFound, "unknown_job", "no job " + std::to_string(id));
+  if (it == s.jobs.end()) return unknown_job(id);
   JobState& job = *it->second;
   if (is_terminal(job.phase))
     return make_error(Code::Conflict, "job_finished", "job " + std::to_string(id) + " is already " + phase_name(job.phase));
@@ -317,7 +329,7 @@ Status Coordinator::set_priority(uint64_t id, int priority) {
   Impl& s = *impl_;
   std::lock_guard<std::mutex> lock(s.mu);
   auto it = s.jobs.find(id);
-  if (it == s.jobs.end()) return make_error(Code::NotFound, "unknown_job", "no job " + std::to_string(id));
+  if (it == s.jobs.end()) return unknown_job(id);
   try {
     s.store.set_job_priority(id, priority);
   } catch (const std::exception& e) {
@@ -333,7 +345,7 @@ Status Coordinator::retry_job(uint64_t id) {
   Impl& s = *impl_;
   std::lock_guard<std::mutex> lock(s.mu);
   auto it = s.jobs.find(id);
-  if (it == s.jobs.end()) return make_error(Code::NotFound, "unknown_job", "no job " + std::to_string(id));
+  if (it == s.jobs.end()) return unknown_job(id);
   JobState& old = *it->second;
   if (old.phase != JobPhase::Failed && old.phase != JobPhase::Cancelled)
     return make_error(Code::Conflict, "job_not_ended",

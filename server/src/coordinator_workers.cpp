@@ -202,7 +202,7 @@ Result<json> Coordinator::upload_result(uint64_t worker, uint64_t lease, std::st
   if (!w) return unknown_worker(worker);
   w->last_seen = Clock::now();
   auto it = s.jobs.find(result.job_id);
-  if (it == s.jobs.end()) return make_error(Code::NotFound, "unknown_job", "no job " + std::to_string(result.job_id));
+  if (it == s.jobs.end()) return unknown_job(result.job_id);
   JobState& job = *it->second;
   if (job.phase == JobPhase::Cancelled || job.phase == JobPhase::Failed)
     return make_error(Code::Gone, "job_ended", "job " + std::to_string(job.id()) + " is " + phase_name(job.phase));

@@ -126,12 +126,4 @@ size_t SceneCache::loaded_scenes() const {
   return entries_.size();
 }
 
-uint64_t SceneCache::loaded_bytes() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  uint64_t total = 0;
-  for (auto& [k, e] : entries_)
-    if (e.scene.wait_for(std::chrono::seconds(0)) == std::future_status::ready) total += e.scene.get()->bytes;
-  return total;
-}
-
 }  // namespace tessera::farm

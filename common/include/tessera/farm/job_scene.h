@@ -1,6 +1,7 @@
 // Loading a job's scene the same way everywhere: the coordinator at submission (to fail fast and
-// learn the film), each worker before rendering, and `tessera render` for the same settings. One
-// function so that the three can never disagree about what the settings mean.
+// learn the film), each worker before rendering, and `tessera submit` before bundling. One function
+// so that they can never disagree about what the settings mean. (`tessera render` loads through
+// the same parse_scene_file/load_scene with the same options, timing each step itself.)
 #pragma once
 
 #include "tessera/farm/protocol.h"

@@ -44,8 +44,6 @@ class Coordinator {
   Coordinator(const Coordinator&) = delete;
   Coordinator& operator=(const Coordinator&) = delete;
 
-  const CoordinatorOptions& options() const;
-
   // Scenes: bundles stored content-addressed by SHA-256.
   Result<nlohmann::json> upload_scene(const std::string& bundle);
   /// Path of the stored bundle file.

@@ -32,7 +32,6 @@ class SceneCache {
   std::shared_ptr<const CachedScene> get(const Lease& lease, const FarmClient& client);
 
   size_t loaded_scenes() const;
-  uint64_t loaded_bytes() const;
   /// Number of bundle downloads so far (a test checks each bundle is fetched once).
   uint64_t downloads() const { return downloads_; }
 
