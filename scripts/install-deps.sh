@@ -9,8 +9,24 @@ packages=(
   nlohmann-json3-dev libtinyobjloader-dev libpugixml-dev libstb-dev libspdlog-dev libfmt-dev
   libtbb-dev libcli11-dev libopenexr-dev libimath-dev zlib1g-dev
   libcpp-httplib-dev libsqlite3-dev libssl-dev libzstd-dev libarchive-dev
-  curl bc
+  curl bc openssl
+  python3-yaml iproute2
+  chromium chromium-driver python3-selenium
 )
+
+# What the built programs load at run time: the runtime stage of docker/Dockerfile installs only
+# these (--runtime), plus curl for its HEALTHCHECK. tests/deploy checks them against the binaries.
+runtime_packages=(
+  libc6 libgcc-s1 libstdc++6 libtbb12 libopenexr-3-1-30 libpugixml1v5 libtinyobjloader2rc10 libstb0
+  libspdlog1.10 libfmt9 zlib1g libzstd1 libarchive13 libssl3 libsqlite3-0 libcpp-httplib0.11
+  ca-certificates curl
+)
+case "${1:-}" in
+  "") ;;
+  --runtime) packages=("${runtime_packages[@]}") ;;
+  --list-runtime) printf '%s\n' "${runtime_packages[@]}"; exit 0 ;;
+  *) echo "usage: install-deps.sh [--runtime | --list-runtime]" >&2; exit 2 ;;
+esac
 
 missing=()
 for p in "${packages[@]}"; do

@@ -74,6 +74,8 @@ int main_entry(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   sub->add_option("--server", submit.server, "Coordinator URL (default: $TESSERA_SERVER or http://127.0.0.1:8420)");
   sub->add_option("--token-file", submit.token_file, "Client token file (default: $TESSERA_CLIENT_TOKEN)");
+  sub->add_option("--ca-file", submit.ca_file, "PEM file to verify an https server (default: system CAs)")
+      ->check(CLI::ExistingFile);
   sub->add_option("-o,--output", submit.outputs, "Wait, then download the image(s): .exr, .pfm or .png");
   sub->add_flag("--wait", submit.wait, "Wait for the job to finish, with a progress bar");
   sub->add_option("--spp", submit.spp, "Samples per pixel (default: the scene's)")->check(CLI::PositiveNumber);
@@ -93,10 +95,12 @@ int main_entry(int argc, char** argv) {
   JobsOptions jobs;
   auto* jl = app.add_subcommand("jobs", "List a coordinator's jobs");
   jl->add_option("--token-file", jobs.token_file, "Client token file (default: $TESSERA_CLIENT_TOKEN)");
+  jl->add_option("--ca-file", jobs.ca_file, "PEM file to verify an https server")->check(CLI::ExistingFile);
   jl->add_option("--server", jobs.server, "Coordinator URL (default: $TESSERA_SERVER or http://127.0.0.1:8420)");
   auto* cancel = app.add_subcommand("cancel", "Cancel a job");
   cancel->add_option("id", jobs.cancel_id, "Job id")->required();
   cancel->add_option("--token-file", jobs.token_file, "Client token file (default: $TESSERA_CLIENT_TOKEN)");
+  cancel->add_option("--ca-file", jobs.ca_file, "PEM file to verify an https server")->check(CLI::ExistingFile);
   cancel->add_option("--server", jobs.server, "Coordinator URL (default: $TESSERA_SERVER or http://127.0.0.1:8420)");
 
   CLI11_PARSE(app, argc, argv);

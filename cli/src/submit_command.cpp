@@ -29,10 +29,11 @@ namespace {
 
 // The coordinator's client, with the client token from --token-file or $TESSERA_CLIENT_TOKEN;
 // false (the reason printed, prefixed by `who`) if the token file cannot be read.
-bool make_client(const std::string& server, const std::string& token_file, const char* who, farm::FarmClient& out) {
+bool make_client(const std::string& server, const std::string& token_file, const std::string& ca_file,
+                 const char* who, farm::FarmClient& out) {
   try {
     out = farm::FarmClient(server.empty() ? default_server_url() : server,
-                           resolve_token("", token_file, "TESSERA_CLIENT_TOKEN"));
+                           resolve_token("", token_file, "TESSERA_CLIENT_TOKEN"), ca_file);
     return true;
   } catch (const std::exception& e) {
     std::cerr << who << ": " << e.what() << "\n";
@@ -95,7 +96,7 @@ int run_submit(const SubmitOptions& o) {
     }
   }
   farm::FarmClient client("");
-  if (!make_client(o.server, o.token_file, "tessera submit", client)) return 2;
+  if (!make_client(o.server, o.token_file, o.ca_file, "tessera submit", client)) return 2;
   std::string why;
   if (!client.valid(&why)) {
     std::cerr << "tessera submit: " << why << "\n";
@@ -153,7 +154,7 @@ int run_submit(const SubmitOptions& o) {
 
 int run_jobs(const JobsOptions& o) {
   farm::FarmClient client("");
-  if (!make_client(o.server, o.token_file, "tessera jobs", client)) return 2;
+  if (!make_client(o.server, o.token_file, o.ca_file, "tessera jobs", client)) return 2;
   farm::HttpReply r = client.get("/api/v1/jobs");
   json j = r.json();
   if (!r.ok() || !j.is_object()) {
@@ -170,7 +171,7 @@ int run_jobs(const JobsOptions& o) {
 
 int run_cancel(const JobsOptions& o) {
   farm::FarmClient client("");
-  if (!make_client(o.server, o.token_file, "tessera cancel", client)) return 2;
+  if (!make_client(o.server, o.token_file, o.ca_file, "tessera cancel", client)) return 2;
   farm::HttpReply r = client.del("/api/v1/jobs/" + std::to_string(o.cancel_id));
   if (!r.ok()) {
     std::cerr << "tessera cancel: " << r.describe() << "\n";

@@ -1,5 +1,6 @@
 // Construction, resume after a restart, lease expiry, health and shutdown.
 #include "coordinator_impl.h"
+#include "event_log.h"
 
 #include "tessera/farm/tile_result.h"
 #include "tessera/image/image.h"
@@ -31,6 +32,7 @@ int http_status(Code code) {
     case Code::Gone: return 410;
     case Code::PayloadTooLarge: return 413;
     case Code::Unprocessable: return 422;
+    case Code::TooManyRequests: return 429;
     case Code::Unavailable: return 503;
     case Code::Internal: return 500;
     case Code::InsufficientStorage: return 507;
@@ -157,8 +159,8 @@ void Coordinator::Impl::reap_loop() {
     for (auto it = leases.begin(); it != leases.end();) {
       auto next = std::next(it);
       if (it->second.expires < now) {
-        spdlog::warn("lease {} (job {}, unit {}) of worker {} expired; re-issuing", it->first, it->second.job,
-                     it->second.unit, it->second.worker);
+        log_event(spdlog::level::warn, "lease.expired",
+                  {{"lease", it->first}, {"job", it->second.job}, {"unit", it->second.unit}, {"worker", it->second.worker}});
         ++counters.expired;
         end_lease(it);
       }
@@ -166,7 +168,10 @@ void Coordinator::Impl::reap_loop() {
     }
     const auto silent = std::chrono::duration<double>(opt.lease_timeout);
     for (auto& [id, w] : workers)
-      if ((w.state == "idle" || w.state == "busy") && now - w.last_seen > silent) w.state = "lost";
+      if ((w.state == "idle" || w.state == "busy") && now - w.last_seen > silent) {
+        w.state = "lost";
+        log_event(spdlog::level::warn, "worker.lost", {{"worker", id}, {"name", w.row.name}});
+      }
   }
 }
 

@@ -69,6 +69,8 @@ struct Coordinator::Impl {
   std::unique_ptr<JobState> job_from_row(const JobRow& row) const;
   /// A job rebuilt from its row and every stored result (its film included).
   std::unique_ptr<JobState> rebuild_job(const JobRow& row);
+  /// Under `mu`: 429 beyond --max-active-jobs queued and running jobs.
+  Status check_active_jobs() const;
   /// Under `mu`: job status as JSON.
   nlohmann::json status_json(const JobState& job);
   /// Expires leases and marks silent workers lost, once a second.

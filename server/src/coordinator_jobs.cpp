@@ -1,6 +1,7 @@
 // Scenes and jobs: upload, submit (the scene is loaded here, so a broken one fails the request),
 // status, image, cancel.
 #include "coordinator_impl.h"
+#include "event_log.h"
 
 #include "tessera/farm/sha256.h"
 #include "tessera/image/image.h"
@@ -71,7 +72,19 @@ std::string strip_dir(std::string msg, const std::string& dir) {
 
 std::mutex unpack_mutex;  // one unpack per bundle at a time
 
+
 }  // namespace
+
+// Checked before the scene is loaded, so a flood of submissions costs no unpacking, and again
+// before the job is stored.
+Status Coordinator::Impl::check_active_jobs() const {
+  int active = 0;
+  for (const auto& [id, job] : jobs) active += is_terminal(job->phase) ? 0 : 1;
+  if (active < opt.max_active_jobs) return Status::success();
+  return make_error(Code::TooManyRequests, "too_many_jobs",
+                    std::to_string(active) + " jobs are queued or running; the limit is " +
+                        std::to_string(opt.max_active_jobs) + " (retry when some have finished)");
+}
 
 Result<json> Coordinator::upload_scene(const std::string& bundle) {
   Impl& s = *impl_;
@@ -121,6 +134,10 @@ Result<json> Coordinator::submit_job(const json& body, const std::string& bundle
   std::string error;
   if (!job_settings_from_json(body, settings, error, bundle.empty()))
     return make_error(Code::BadRequest, "bad_settings", error);
+  {
+    std::lock_guard<std::mutex> lock(s.mu);
+    if (Status st = s.check_active_jobs(); !st.ok()) return st;
+  }
   if (!bundle.empty()) {
     Result<json> uploaded = upload_scene(bundle);
     if (!uploaded.ok()) return uploaded.status;
@@ -161,13 +178,15 @@ Result<json> Coordinator::submit_job(const json& body, const std::string& bundle
 
   std::lock_guard<std::mutex> lock(s.mu);
   if (s.stopping) return make_error(Code::Unavailable, "stopping", "the coordinator is shutting down");
+  if (Status st = s.check_active_jobs(); !st.ok()) return st;
   try {
     const double now = wall_seconds();
     uint64_t id = s.store.add_job(settings.name, to_json(plan).dump(), settings.priority, now);
     auto job = std::make_unique<JobState>(id, std::move(plan), settings.name, settings.priority, now);
-    spdlog::info("job {} submitted: '{}', {}x{}, {} spp, {} tiles x {} passes", id, settings.name,
-                 job->plan().window.width(), job->plan().window.height(), job->plan().settings.spp, job->num_tiles(),
-                 job->num_passes());
+    log_event(spdlog::level::info, "job.submitted",
+              {{"job", id}, {"name", settings.name}, {"width", job->plan().window.width()},
+               {"height", job->plan().window.height()}, {"spp", job->plan().settings.spp}, {"tiles", job->num_tiles()},
+               {"passes", job->num_passes()}, {"scene", settings.scene}});
     json status = s.status_json(*job);
     s.jobs.emplace(id, std::move(job));
     s.work_cv.notify_all();
@@ -321,7 +340,7 @@ Status Coordinator::cancel_job(uint64_t id) {
   } catch (const std::exception& e) {
     return internal_error(e);
   }
-  spdlog::info("job {} cancelled", id);
+  log_event(spdlog::level::info, "job.cancelled", {{"job", id}});
   return Status::success();
 }
 
@@ -336,7 +355,7 @@ Status Coordinator::set_priority(uint64_t id, int priority) {
     return internal_error(e);
   }
   it->second->set_priority(priority);
-  spdlog::info("job {}: priority {}", id, priority);
+  log_event(spdlog::level::info, "job.priority", {{"job", id}, {"priority", priority}});
   s.work_cv.notify_all();
   return Status::success();
 }
@@ -355,7 +374,7 @@ Status Coordinator::retry_job(uint64_t id) {
     JobRow row{id, old.name(), to_json(old.plan()).dump(), "queued", "", old.priority(), old.created(), old.started, 0};
     auto job = s.rebuild_job(row);
     s.save_phase(*job);
-    spdlog::info("job {} queued again with {} of {} passes done", id, job->done_units(), job->num_units());
+    log_event(spdlog::level::info, "job.retried", {{"job", id}, {"units_done", job->done_units()}, {"units", job->num_units()}});
     it->second = std::move(job);
   } catch (const std::exception& e) {
     return internal_error(e);

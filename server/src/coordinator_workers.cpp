@@ -1,6 +1,7 @@
 // Workers and leases: registration (with the build check), long-poll leasing, heartbeats, results,
 // failures and sign-off.
 #include "coordinator_impl.h"
+#include "event_log.h"
 
 #include "tessera/farm/tile_result.h"
 
@@ -36,7 +37,7 @@ Result<json> Coordinator::register_worker(const json& body) {
   std::string mismatch =
       fingerprint_mismatch(s.fingerprint, BuildFingerprint{hello.version, hello.isa, hello.probe});
   if (!mismatch.empty()) {
-    spdlog::warn("refused worker '{}': {}", hello.name, mismatch);
+    log_event(spdlog::level::warn, "worker.refused", {{"name", hello.name}, {"reason", mismatch}});
     return make_error(Code::Conflict, "incompatible_worker", mismatch);
   }
   std::lock_guard<std::mutex> lock(s.mu);
@@ -46,7 +47,8 @@ Result<json> Coordinator::register_worker(const json& body) {
     WorkerInfo& w = s.workers[row.id];
     w.row = row;
     w.last_seen = Clock::now();
-    spdlog::info("worker {} registered: '{}', {} threads, {}", row.id, hello.name, hello.threads, hello.isa);
+    log_event(spdlog::level::info, "worker.registered",
+              {{"worker", row.id}, {"name", hello.name}, {"threads", hello.threads}, {"isa", hello.isa}});
     return json{{"id", row.id},
                 {"lease_timeout", s.opt.lease_timeout},
                 {"heartbeat_seconds", s.opt.lease_timeout / 4},
@@ -115,6 +117,7 @@ Result<json> Coordinator::lease(uint64_t worker, double wait_seconds) {
           best->phase = JobPhase::Running;
           best->started = now;
           s.save_phase(*best);
+          log_event(spdlog::level::info, "job.started", {{"job", best->id()}});
         }
         w->state = "busy";
         json j = to_json(l);
@@ -122,6 +125,8 @@ Result<json> Coordinator::lease(uint64_t worker, double wait_seconds) {
         best->lease_bytes += bytes;
         s.counters.bytes_out += bytes;
         ++s.counters.leased;
+        log_event(spdlog::level::debug, "lease.issued",
+                  {{"lease", l.id}, {"job", l.job_id}, {"tile", l.tile}, {"pass", l.pass}, {"worker", worker}});
         s.lease_wait.observe(std::chrono::duration<double>(Clock::now() - t0).count());
         return j;
       } catch (const std::exception& e) {
@@ -235,6 +240,8 @@ Result<json> Coordinator::upload_result(uint64_t worker, uint64_t lease, std::st
   (void)job.add_result(unit, std::move(result.film), worker);
   job.result_bytes += bytes.size();
   ++s.counters.done;
+  log_event(spdlog::level::debug, "lease.done",
+            {{"lease", lease}, {"job", job.id()}, {"unit", unit}, {"worker", worker}, {"seconds", result.seconds}});
   s.counters.bytes_in += bytes.size();
   w->units_done += 1;
   w->samples_done += samples;
@@ -247,7 +254,7 @@ Result<json> Coordinator::upload_result(uint64_t worker, uint64_t lease, std::st
     } catch (const std::exception& e) {
       return internal_error(e);
     }
-    spdlog::info("job {} done in {:.2f} s", job.id(), job.finished - job.started);
+    log_event(spdlog::level::info, "job.done", {{"job", job.id()}, {"seconds", job.finished - job.started}});
   }
   (void)lease;
   s.upload_seconds.observe(std::chrono::duration<double>(Clock::now() - t0).count());
@@ -271,7 +278,7 @@ Status Coordinator::fail_lease(uint64_t worker, uint64_t lease, const json& body
   ++job.failures_by_worker[worker];
   ++s.counters.failed;
   job.last_failure = reason;
-  spdlog::warn("job {}: worker {} failed a pass: {}", job.id(), worker, reason);
+  log_event(spdlog::level::warn, "lease.failed", {{"lease", lease}, {"job", job.id()}, {"worker", worker}, {"reason", reason}});
   // The job fails when its work fails on several workers (or on every worker there is).
   size_t live = 0;
   for (auto& [id, w] : s.workers) live += w.state == "idle" || w.state == "busy";
@@ -285,7 +292,7 @@ Status Coordinator::fail_lease(uint64_t worker, uint64_t lease, const json& body
       if (l->second.job == job.id()) s.end_lease(l);
       l = next;
     }
-    spdlog::error("job {} failed: {}", job.id(), job.error);
+    log_event(spdlog::level::err, "job.failed", {{"job", job.id()}, {"reason", job.error}});
   }
   try {
     s.save_phase(job);
@@ -311,7 +318,7 @@ Status Coordinator::sign_off(uint64_t worker, const json& body) {
   } catch (const std::exception& e) {
     return internal_error(e);
   }
-  spdlog::info("worker {} signed off", worker);
+  log_event(spdlog::level::info, "worker.signed_off", {{"worker", worker}});
   return Status::success();
 }
 
@@ -323,7 +330,7 @@ Status Coordinator::drain_worker(uint64_t worker) {
   if (w->state == "gone") return make_error(Code::Conflict, "worker_gone", "worker " + std::to_string(worker) + " signed off");
   w->state = "draining";
   s.work_cv.notify_all();  // its waiting polls return now
-  spdlog::info("worker {} draining", worker);
+  log_event(spdlog::level::info, "worker.draining", {{"worker", worker}});
   return Status::success();
 }
 

@@ -1,5 +1,10 @@
 #include "tessera/server/http_api.h"
 
+#include "connection_guard.h"
+#include "event_log.h"
+
+#include "dashboard.h"
+
 #include <httplib.h>
 #include <spdlog/spdlog.h>
 
@@ -72,10 +77,17 @@ std::string bundle_of(const httplib::Request& req) {
 
 }  // namespace
 
-void install_routes(httplib::Server& http, Coordinator& c, const AuthTokens& tokens) {
+void install_routes(httplib::Server& http, Coordinator& c, const AuthTokens& tokens, ConnectionGuard* guard) {
+  auto peer = [](const httplib::Request& req) { return req.remote_addr + ":" + std::to_string(req.remote_port); };
+  http.set_logger([guard, peer](const httplib::Request& req, const httplib::Response& res) {
+    if (guard) guard->request_finished(peer(req));
+    log_event(spdlog::level::debug, "http.request",
+              {{"method", req.method}, {"path", req.path}, {"status", res.status}, {"peer", peer(req)}});
+  });
   // Runs before the body is read: a stranger's upload is refused without being received (the
   // connection is then closed). The answer is the same for a missing and a wrong token.
-  http.set_pre_routing_handler([tokens](const httplib::Request& req, httplib::Response& res) {
+  http.set_pre_routing_handler([tokens, guard, peer](const httplib::Request& req, httplib::Response& res) {
+    if (guard) guard->request_started(peer(req));
     if (authorized(tokens, required_access(req.method, req.path), req.get_header_value("Authorization")))
       return httplib::Server::HandlerResponse::Unhandled;
     res.set_header("WWW-Authenticate", "Bearer");
@@ -85,6 +97,7 @@ void install_routes(httplib::Server& http, Coordinator& c, const AuthTokens& tok
   });
 
   http.Get("/healthz", [&c](const httplib::Request&, httplib::Response& res) { send_json(res, 200, c.health()); });
+  install_dashboard(http);
 
   http.Get("/metrics", [&c](const httplib::Request&, httplib::Response& res) {
     res.set_content(c.metrics(), "text/plain; version=0.0.4");
@@ -205,7 +218,7 @@ void install_routes(httplib::Server& http, Coordinator& c, const AuthTokens& tok
       what = e.what();
     } catch (...) {
     }
-    spdlog::error("{} {}: {}", req.method, req.path, what);
+    log_event(spdlog::level::err, "http.exception", {{"method", req.method}, {"path", req.path}, {"error", what}});
     send_json(res, 500, json{{"error", "internal"}, {"detail", what}});
   });
 }

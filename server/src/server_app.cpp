@@ -1,9 +1,10 @@
 #include "tessera/server/server_app.h"
 
+#include "connection_guard.h"
+#include "event_log.h"
 #include "tessera/farm/protocol.h"
 #include "tessera/server/http_api.h"
 
-#include <CLI/CLI.hpp>
 #include <httplib.h>
 #include <spdlog/spdlog.h>
 
@@ -20,36 +21,6 @@ namespace tessera::server {
 
 namespace fs = std::filesystem;
 
-int parse_server_args(int argc, char** argv, ServerOptions& o) {
-  CLI::App app{"tessera-server: the Tessera render farm coordinator"};
-  CoordinatorOptions& c = o.coordinator;
-  app.add_option("--listen", o.listen, "HOST:PORT to listen on (port 0: any free port)")->capture_default_str();
-  app.add_option("--port-file", o.port_file, "write the port actually bound to this file");
-  app.add_option("--data-dir", c.data_dir, "directory for the state database, bundles and scenes")->capture_default_str();
-  app.add_option("--http-threads", o.http_threads, "HTTP worker threads (long polls use at most half of them)")
-      ->check(CLI::Range(2, 4096))->capture_default_str();
-  app.add_option("--local-workers", o.local_workers, "also run N workers on this machine")->check(CLI::Range(0, 256));
-  app.add_option("--local-worker-threads", o.local_worker_threads, "threads per local worker (default: cores / N)");
-  app.add_option("--worker-binary", o.worker_binary, "the tessera-worker program for --local-workers");
-  app.add_option("--lease-timeout", c.lease_timeout, "seconds without a heartbeat before a lease is re-issued")
-      ->check(CLI::Range(0.5, 3600.0))->capture_default_str();
-  app.add_option("--max-poll-wait", c.max_poll_wait, "longest lease long poll, seconds")
-      ->check(CLI::Range(0.0, 30.0))->capture_default_str();
-  app.add_option("--max-upload", c.max_upload_bytes, "largest scene bundle accepted, bytes")->capture_default_str();
-  app.add_option("--client-token", o.client_token, "bearer token for clients (else $TESSERA_CLIENT_TOKEN)");
-  app.add_option("--client-token-file", o.client_token_file, "read the client token from this file");
-  app.add_option("--worker-token", o.worker_token, "bearer token for workers (else $TESSERA_WORKER_TOKEN)");
-  app.add_option("--worker-token-file", o.worker_token_file, "read the worker token from this file");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e);
-  }
-  // Long polls may hold at most half the HTTP threads; the rest always serve clients.
-  c.max_waiting_polls = std::max(1, o.http_threads / 2);
-  return -1;
-}
-
 namespace {
 
 std::string find_worker_binary(const ServerOptions& o) {
@@ -62,7 +33,7 @@ std::string find_worker_binary(const ServerOptions& o) {
 }
 
 pid_t spawn_worker(const std::string& binary, const std::string& url, int threads, int index,
-                   const std::string& cache, const std::string& token) {
+                   const std::string& cache, const std::string& token, const std::string& ca_file) {
   // The worker token travels in the environment (never on a command line that `ps` shows).
   std::vector<std::string> env;
   for (char** e = environ; *e; ++e)
@@ -70,6 +41,8 @@ pid_t spawn_worker(const std::string& binary, const std::string& url, int thread
   if (!token.empty()) env.push_back("TESSERA_WORKER_TOKEN=" + token);
   std::vector<std::string> args = {binary, "--server", url, "--threads", std::to_string(threads),
                                    "--name", "local-" + std::to_string(index), "--cache-dir", cache};
+  // Over https the local workers trust the server's own certificate (it must name --listen's host).
+  if (!ca_file.empty()) args.insert(args.end(), {"--ca-file", ca_file});
   pid_t pid = fork();
   if (pid == 0) {
     sigset_t none;
@@ -114,6 +87,12 @@ int run_server(const ServerOptions& o) {
     return 2;
   }
 
+  try {
+    configure_logging(o.log_format, o.log_level);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "tessera-server: %s\n", e.what());
+    return 2;
+  }
   AuthTokens tokens;
   try {
     tokens.client = resolve_token(o.client_token, o.client_token_file, "TESSERA_CLIENT_TOKEN");
@@ -133,7 +112,20 @@ int run_server(const ServerOptions& o) {
     return 1;
   }
 
-  httplib::Server http;
+  const bool tls = !o.tls_cert.empty();
+  std::unique_ptr<httplib::Server> http_ptr;
+  if (tls) {
+    auto ssl = std::make_unique<httplib::SSLServer>(o.tls_cert.c_str(), o.tls_key.c_str());
+    if (!ssl->is_valid()) {
+      std::fprintf(stderr, "tessera-server: cannot use --tls-cert '%s' with --tls-key '%s' (not PEM, or the key does not match)\n",
+                   o.tls_cert.c_str(), o.tls_key.c_str());
+      return 2;
+    }
+    http_ptr = std::move(ssl);
+  } else {
+    http_ptr = std::make_unique<httplib::Server>();
+  }
+  httplib::Server& http = *http_ptr;
   const int threads = o.http_threads;
   http.new_task_queue = [threads] { return new httplib::ThreadPool(size_t(threads)); };
   // A kept-alive idle connection holds an HTTP thread; keep that short so idle clients and
@@ -141,7 +133,6 @@ int run_server(const ServerOptions& o) {
   http.set_keep_alive_timeout(2);
   http.set_read_timeout(60);
   http.set_payload_max_length(size_t(o.coordinator.max_upload_bytes) + (size_t(16) << 20));
-  install_routes(http, *coordinator, tokens);
   // cpp-httplib 0.11 listens with a backlog of 5; a few hundred workers connecting at once would
   // overflow it (dropped handshakes, failed requests). Keep the socket and widen the backlog after
   // bind: listen() on a listening socket only changes its backlog.
@@ -156,10 +147,14 @@ int run_server(const ServerOptions& o) {
     return 1;
   }
   if (listen_fd >= 0) ::listen(listen_fd, 4096);
+  ConnectionGuard guard(bound, o.header_timeout);
+  install_routes(http, *coordinator, tokens, &guard);
   if (!o.port_file.empty()) std::ofstream(o.port_file) << bound << "\n";
-  const std::string url = "http://" + (host == "0.0.0.0" ? std::string("127.0.0.1") : host) + ":" + std::to_string(bound);
-  spdlog::info("tessera-server {} listening on {} (data in {}, {} HTTP threads)", TESSERA_VERSION, url,
-               o.coordinator.data_dir, threads);
+  const std::string local_host = host == "0.0.0.0" || host == "::" ? std::string("127.0.0.1") : host;
+  const std::string url = (tls ? "https://" : "http://") + local_host + ":" + std::to_string(bound);
+  log_event(spdlog::level::info, "server.listening",
+            {{"version", TESSERA_VERSION}, {"url", url}, {"data_dir", o.coordinator.data_dir}, {"http_threads", threads},
+             {"tls", tls}, {"tokens", tokens.enabled()}});
   std::thread listener([&http] { http.listen_after_bind(); });
 
   // Local workers: restarted if they die, stopped with the server.
@@ -171,7 +166,7 @@ int run_server(const ServerOptions& o) {
   auto cache = [&](int i) {
     return (fs::path(o.coordinator.data_dir) / "local-workers" / std::to_string(i)).string();
   };
-  for (int i = 0; i < o.local_workers; ++i) children[size_t(i)] = spawn_worker(binary, url, per_worker, i, cache(i), tokens.worker);
+  for (int i = 0; i < o.local_workers; ++i) children[size_t(i)] = spawn_worker(binary, url, per_worker, i, cache(i), tokens.worker, o.tls_cert);
 
   int exit_code = 0;
   for (;;) {
@@ -185,7 +180,7 @@ int run_server(const ServerOptions& o) {
       int status = 0;
       if (children[size_t(i)] > 0 && waitpid(children[size_t(i)], &status, WNOHANG) == children[size_t(i)]) {
         spdlog::warn("local worker {} exited (status {}); restarting it", i, status);
-        children[size_t(i)] = spawn_worker(binary, url, per_worker, i, cache(i), tokens.worker);
+        children[size_t(i)] = spawn_worker(binary, url, per_worker, i, cache(i), tokens.worker, o.tls_cert);
       }
     }
   }

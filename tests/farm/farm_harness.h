@@ -127,6 +127,12 @@ class Farm {
   }
   void kill_server() { server_.kill_now(); }
   int stop_server() { return server_.terminate(); }
+  /// Serve https with this certificate and key; the harness's client and workers verify against
+  /// `ca_file` (the certificate itself, when self-signed).
+  void use_tls(const std::string& cert, const std::string& key, const std::string& ca_file) {
+    flags_.insert(flags_.end(), {"--tls-cert", cert, "--tls-key", key});
+    ca_file_ = ca_file;
+  }
   /// Tokens the harness's client and workers use (the server's flags set the real ones).
   void set_tokens(std::string client, std::string worker) {
     client_token_ = std::move(client);
@@ -137,6 +143,7 @@ class Farm {
     std::vector<std::string> args = {TESSERA_WORKER_BIN, "--server", url(), "--threads", std::to_string(threads),
                                      "--name", "w" + n, "--cache-dir", (dir_.path / ("cache" + n)).string(),
                                      "--poll-wait", "2"};
+    if (!ca_file_.empty()) args.insert(args.end(), {"--ca-file", ca_file_});
     args.insert(args.end(), extra.begin(), extra.end());
     std::vector<std::string> env;
     if (!worker_token_.empty()) env.push_back("TESSERA_WORKER_TOKEN=" + worker_token_);
@@ -158,8 +165,10 @@ class Farm {
     return false;
   }
 
-  std::string url() const { return "http://127.0.0.1:" + std::to_string(port_); }
-  farm::FarmClient client() const { return farm::FarmClient(url(), client_token_); }
+  std::string url() const { return (ca_file_.empty() ? "http://" : "https://") + std::string("127.0.0.1:") + std::to_string(port_); }
+  int port() const { return port_; }
+  const std::string& ca_file() const { return ca_file_; }
+  farm::FarmClient client() const { return farm::FarmClient(url(), client_token_, ca_file_); }
   const TempDir& dir() const { return dir_; }
   std::string log(const std::string& name) const { return (dir_.path / (name + ".log")).string(); }
 
@@ -204,7 +213,7 @@ class Farm {
  private:
   TempDir dir_;
   std::vector<std::string> flags_;
-  std::string client_token_, worker_token_;
+  std::string client_token_, worker_token_, ca_file_;
   int port_ = 0;
   Child server_;
   std::vector<Child> workers_;

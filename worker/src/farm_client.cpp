@@ -20,10 +20,23 @@ HttpReply reply_of(const httplib::Result& r) {
   return out;
 }
 
-std::unique_ptr<httplib::Client> make_client(const std::string& host, int port, double timeout,
-                                             const std::string& token) {
-  auto c = std::make_unique<httplib::Client>(host, port);
-  if (!token.empty()) c->set_bearer_token_auth(token);
+struct Endpoint {
+  const std::string& host;
+  int port;
+  bool tls;
+  const std::string& token;
+  const std::string& ca_file;
+};
+
+std::unique_ptr<httplib::Client> make_client(const Endpoint& e, double timeout) {
+  const std::string base = (e.tls ? "https://" : "http://") + e.host + ":" + std::to_string(e.port);
+  auto c = std::make_unique<httplib::Client>(base);
+  if (e.tls) {
+    // Never talk TLS to a server we cannot verify: a token sent to an impostor is a token lost.
+    c->enable_server_certificate_verification(true);
+    if (!e.ca_file.empty()) c->set_ca_cert_path(e.ca_file.c_str());
+  }
+  if (!e.token.empty()) c->set_bearer_token_auth(e.token);
   const time_t sec = time_t(timeout);
   const time_t usec = time_t((timeout - double(sec)) * 1e6);
   c->set_connection_timeout(5, 0);
@@ -55,15 +68,22 @@ std::string HttpReply::describe() const {
   return s;
 }
 
-FarmClient::FarmClient(std::string url, std::string token) : url_(std::move(url)), token_(std::move(token)) {
+FarmClient::FarmClient(std::string url, std::string token, std::string ca_file)
+    : url_(std::move(url)), token_(std::move(token)), ca_file_(std::move(ca_file)) {
   while (!url_.empty() && url_.back() == '/') url_.pop_back();
-  const std::string scheme = "http://";
-  if (url_.rfind(scheme, 0) != 0) return;
-  std::string rest = url_.substr(scheme.size());
+  std::string rest;
+  if (url_.rfind("http://", 0) == 0) {
+    rest = url_.substr(7);
+  } else if (url_.rfind("https://", 0) == 0) {
+    rest = url_.substr(8);
+    tls_ = true;
+  } else {
+    return;
+  }
   size_t colon = rest.rfind(':');
   host_ = colon == std::string::npos ? rest : rest.substr(0, colon);
   try {
-    port_ = colon == std::string::npos ? 80 : std::stoi(rest.substr(colon + 1));
+    port_ = colon == std::string::npos ? (tls_ ? 443 : 80) : std::stoi(rest.substr(colon + 1));
   } catch (const std::exception&) {
     port_ = 0;
   }
@@ -71,25 +91,25 @@ FarmClient::FarmClient(std::string url, std::string token) : url_(std::move(url)
 
 bool FarmClient::valid(std::string* why) const {
   if (!host_.empty() && port_ > 0 && port_ < 65536) return true;
-  if (why) *why = "server URL '" + url_ + "' is not http://HOST:PORT";
+  if (why) *why = "server URL '" + url_ + "' is not http://HOST:PORT or https://HOST:PORT";
   return false;
 }
 
 HttpReply FarmClient::get(const std::string& path, double timeout) const {
-  return reply_of(make_client(host_, port_, timeout, token_)->Get(path.c_str()));
+  return reply_of(make_client({host_, port_, tls_, token_, ca_file_}, timeout)->Get(path.c_str()));
 }
 
 HttpReply FarmClient::del(const std::string& path, const json& body, double timeout) const {
-  return reply_of(make_client(host_, port_, timeout, token_)->Delete(path.c_str(), body.dump(), "application/json"));
+  return reply_of(make_client({host_, port_, tls_, token_, ca_file_}, timeout)->Delete(path.c_str(), body.dump(), "application/json"));
 }
 
 HttpReply FarmClient::post_json(const std::string& path, const json& body, double timeout) const {
-  return reply_of(make_client(host_, port_, timeout, token_)->Post(path.c_str(), body.dump(), "application/json"));
+  return reply_of(make_client({host_, port_, tls_, token_, ca_file_}, timeout)->Post(path.c_str(), body.dump(), "application/json"));
 }
 
 HttpReply FarmClient::post_bytes(const std::string& path, const std::string& bytes, const std::string& type,
                                  double timeout) const {
-  return reply_of(make_client(host_, port_, timeout, token_)->Post(path.c_str(), bytes, type.c_str()));
+  return reply_of(make_client({host_, port_, tls_, token_, ca_file_}, timeout)->Post(path.c_str(), bytes, type.c_str()));
 }
 
 HttpReply FarmClient::post_job_with_bundle(const json& settings, const std::string& bundle, double timeout) const {
@@ -97,7 +117,7 @@ HttpReply FarmClient::post_job_with_bundle(const json& settings, const std::stri
       {"settings", settings.dump(), "settings.json", "application/json"},
       {"bundle", bundle, "scene.tar.gz", "application/gzip"},
   };
-  return reply_of(make_client(host_, port_, timeout, token_)->Post("/api/v1/jobs", items));
+  return reply_of(make_client({host_, port_, tls_, token_, ca_file_}, timeout)->Post("/api/v1/jobs", items));
 }
 
 }  // namespace tessera::farm

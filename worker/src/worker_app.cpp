@@ -15,7 +15,9 @@ int worker_main(int argc, char** argv) {
   CLI::App app{"tessera-worker: renders tiles for a Tessera coordinator"};
   WorkerOptions o;
   double budget_mb = 0;
-  app.add_option("--server", o.server, "coordinator URL, http://HOST:PORT")->required();
+  app.add_option("--server", o.server, "coordinator URL, http://HOST:PORT or https://HOST:PORT")->required();
+  app.add_option("--ca-file", o.ca_file, "PEM file to verify an https coordinator's certificate (default: system CAs)")
+      ->check(CLI::ExistingFile);
   app.add_option("--threads", o.threads, "render threads (default: every core)")->check(CLI::Range(0, 4096));
   app.add_option("--cache-dir", o.cache_dir, "where scene bundles are kept (default: ~/.cache/tessera-worker)");
   app.add_option("--name", o.name, "name shown by the coordinator (default: host name)");

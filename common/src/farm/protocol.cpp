@@ -144,6 +144,12 @@ bool check_job_limits(const JobSettings& s, const JobLimits& l, std::string& err
   if (s.tile_size < l.min_tile_size || s.tile_size > l.max_tile_size)
     return fail("tile_size " + std::to_string(s.tile_size) + " is outside " + std::to_string(l.min_tile_size) + ".." +
                 std::to_string(l.max_tile_size));
+  if (s.width > 0 && s.height > 0 && s.tile_size > 0) {
+    const int64_t tiles = int64_t((s.width + s.tile_size - 1) / s.tile_size) * ((s.height + s.tile_size - 1) / s.tile_size);
+    if (tiles > l.max_tiles)
+      return fail(std::to_string(tiles) + " tiles of " + std::to_string(s.tile_size) + " pixels exceed the limit of " +
+                  std::to_string(l.max_tiles) + " tiles (use a larger tile_size)");
+  }
   if (!s.integrator.empty() && s.integrator != "path" && s.integrator != "volpath" && s.integrator != "direct")
     return fail("integrator '" + s.integrator + "' is not path, volpath or direct");
   if (!s.light_selection.empty() && s.light_selection != "power" && s.light_selection != "bvh")

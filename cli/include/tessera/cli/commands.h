@@ -33,6 +33,7 @@ struct CompareOptions {
 struct SubmitOptions {
   std::string scene, server;
   std::string token_file;            // else $TESSERA_CLIENT_TOKEN
+  std::string ca_file;               // verifies an https:// server (else the system's CAs)
   std::vector<std::string> outputs;  // implies wait
   int spp = 0, width = 0, height = 0, tile_size = 32, priority = 0;
   uint32_t seed = 0;
@@ -44,6 +45,7 @@ struct SubmitOptions {
 struct JobsOptions {
   std::string server;
   std::string token_file;  // else $TESSERA_CLIENT_TOKEN
+  std::string ca_file;
   uint64_t cancel_id = 0;  // run_cancel
 };
 

@@ -34,6 +34,7 @@ struct JobLimits {
   int max_resolution = 32768;  // per side
   int64_t max_pixels = int64_t(1) << 28;
   int max_tile_size = 1024, min_tile_size = 4;
+  int64_t max_tiles = int64_t(1) << 20;  // per job (each tile is state on the coordinator)
 };
 
 nlohmann::json to_json(const JobSettings& s);

@@ -29,6 +29,7 @@ struct CoordinatorOptions {
   JobLimits limits;
   BundleLimits bundle_limits;
   uint64_t max_upload_bytes = uint64_t(4) << 30;
+  int max_active_jobs = 10000;  // queued + running; more are refused with 429 until some end
 };
 
 struct ImageBytes {

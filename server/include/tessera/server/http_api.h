@@ -11,8 +11,12 @@ class Server;
 
 namespace tessera::server {
 
+class ConnectionGuard;
+
 /// Installs every /api/v1 route, /healthz, the bearer-token check (before any body is read) and
-/// JSON error and exception handlers.
-void install_routes(httplib::Server& http, Coordinator& coordinator, const AuthTokens& tokens = {});
+/// JSON error and exception handlers. With a guard, every request is reported to it (the
+/// slow-loris watch) and, at debug level, logged as an "http.request" event.
+void install_routes(httplib::Server& http, Coordinator& coordinator, const AuthTokens& tokens = {},
+                    ConnectionGuard* guard = nullptr);
 
 }  // namespace tessera::server

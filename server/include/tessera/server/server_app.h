@@ -16,6 +16,10 @@ struct ServerOptions {
   int local_worker_threads = 0;           // 0: the machine's cores divided among the local workers
   std::string worker_binary;              // default: tessera-worker beside this program
   std::string client_token, client_token_file, worker_token, worker_token_file;  // auth.h
+  std::string tls_cert, tls_key;          // PEM files; both set: serve https only
+  double header_timeout = 10;             // seconds a connection may take to send a request's headers
+  std::string log_format = "text";        // text or json (one JSON object per line)
+  std::string log_level = "info";         // debug shows every lease; info every job state change
   CoordinatorOptions coordinator;
 };
 

@@ -15,6 +15,7 @@ enum class Code {
   Gone,             // 410: the job of a lease was cancelled or has failed
   PayloadTooLarge,  // 413
   Unprocessable,    // 422: well-formed, but the scene or settings cannot be rendered
+  TooManyRequests,  // 429: a limit on outstanding work (queued jobs)
   Unavailable,      // 503: shutting down, or too many waiting requests
   Internal,         // 500
   InsufficientStorage,  // 507: the disk is full

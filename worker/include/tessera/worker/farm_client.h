@@ -23,10 +23,12 @@ struct HttpReply {
 
 class FarmClient {
  public:
-  /// `url`: http://HOST:PORT (a trailing slash is fine); `token`: sent as a bearer token if set.
-  explicit FarmClient(std::string url, std::string token = "");
+  /// `url`: http://HOST:PORT or https://HOST:PORT (a trailing slash is fine); `token`: sent as a
+  /// bearer token if set. Over https the server's certificate is always verified: against
+  /// `ca_file` (PEM) when given, else against the system's trust store.
+  explicit FarmClient(std::string url, std::string token = "", std::string ca_file = "");
   const std::string& url() const { return url_; }
-  /// False with a message if the URL is not http://HOST[:PORT].
+  /// False with a message if the URL is not http(s)://HOST[:PORT].
   bool valid(std::string* why = nullptr) const;
 
   HttpReply get(const std::string& path, double timeout_seconds = 30) const;
@@ -40,8 +42,9 @@ class FarmClient {
                                  double timeout_seconds = 600) const;
 
  private:
-  std::string url_, host_, token_;
+  std::string url_, host_, token_, ca_file_;
   int port_ = 0;
+  bool tls_ = false;
 };
 
 }  // namespace tessera::farm

@@ -18,6 +18,7 @@ namespace tessera::farm {
 struct WorkerOptions {
   std::string server;          // http://HOST:PORT
   std::string token;           // the worker bearer token (empty: the farm is open)
+  std::string ca_file;         // PEM certificate(s) to verify an https:// coordinator with
   int threads = 0;             // 0: every core
   std::string cache_dir;       // default: $XDG_CACHE_HOME/tessera-worker or ~/.cache/...
   std::string name;            // default: hostname

@@ -1,0 +1,70 @@
+// tessera-server's command line. Every limit a hostile or careless client could hit is a flag, so
+// an operator can tighten it without a rebuild (docs/api.md lists them with their errors).
+#include "tessera/server/server_app.h"
+
+#include <CLI/CLI.hpp>
+
+namespace tessera::server {
+
+int parse_server_args(int argc, char** argv, ServerOptions& o) {
+  CLI::App app{"tessera-server: the Tessera render farm coordinator"};
+  CoordinatorOptions& c = o.coordinator;
+  app.add_option("--listen", o.listen, "HOST:PORT to listen on (port 0: any free port)")->capture_default_str();
+  app.add_option("--port-file", o.port_file, "write the port actually bound to this file");
+  app.add_option("--data-dir", c.data_dir, "directory for the state database, bundles and scenes")->capture_default_str();
+  app.add_option("--http-threads", o.http_threads, "HTTP worker threads (long polls use at most half of them)")
+      ->check(CLI::Range(2, 4096))->capture_default_str();
+  app.add_option("--local-workers", o.local_workers, "also run N workers on this machine")->check(CLI::Range(0, 256));
+  app.add_option("--local-worker-threads", o.local_worker_threads, "threads per local worker (default: cores / N)");
+  app.add_option("--worker-binary", o.worker_binary, "the tessera-worker program for --local-workers");
+  app.add_option("--lease-timeout", c.lease_timeout, "seconds without a heartbeat before a lease is re-issued")
+      ->check(CLI::Range(0.5, 3600.0))->capture_default_str();
+  app.add_option("--max-poll-wait", c.max_poll_wait, "longest lease long poll, seconds")
+      ->check(CLI::Range(0.0, 30.0))->capture_default_str();
+
+  auto* security = "Security";
+  app.add_option("--client-token", o.client_token, "bearer token for clients (else $TESSERA_CLIENT_TOKEN)")->group(security);
+  app.add_option("--client-token-file", o.client_token_file, "read the client token from this file")->group(security);
+  app.add_option("--worker-token", o.worker_token, "bearer token for workers (else $TESSERA_WORKER_TOKEN)")->group(security);
+  app.add_option("--worker-token-file", o.worker_token_file, "read the worker token from this file")->group(security);
+  auto* cert = app.add_option("--tls-cert", o.tls_cert, "PEM certificate (chain): serve https")
+                   ->check(CLI::ExistingFile)->group(security);
+  auto* key = app.add_option("--tls-key", o.tls_key, "PEM private key of --tls-cert")->check(CLI::ExistingFile)->group(security);
+  cert->needs(key);
+  key->needs(cert);
+  app.add_option("--header-timeout", o.header_timeout,
+                 "seconds a connection may take to send a request's headers (slow clients are cut off)")
+      ->check(CLI::Range(0.5, 600.0))->capture_default_str()->group(security);
+
+  auto* limits = "Limits";
+  app.add_option("--max-upload", c.max_upload_bytes, "largest scene bundle accepted, bytes")->capture_default_str()->group(limits);
+  app.add_option("--max-unpacked", c.bundle_limits.max_unpacked_bytes, "largest unpacked bundle, bytes")
+      ->capture_default_str()->group(limits);
+  app.add_option("--max-files", c.bundle_limits.max_files, "most entries in a bundle")->capture_default_str()->group(limits);
+  app.add_option("--max-spp", c.limits.max_spp, "most samples per pixel of a job")
+      ->check(CLI::PositiveNumber)->capture_default_str()->group(limits);
+  app.add_option("--max-resolution", c.limits.max_resolution, "largest image side, pixels")
+      ->check(CLI::PositiveNumber)->capture_default_str()->group(limits);
+  app.add_option("--max-pixels", c.limits.max_pixels, "most pixels of an image")->check(CLI::PositiveNumber)
+      ->capture_default_str()->group(limits);
+  app.add_option("--max-tiles", c.limits.max_tiles, "most tiles of a job")->check(CLI::PositiveNumber)
+      ->capture_default_str()->group(limits);
+  app.add_option("--max-active-jobs", c.max_active_jobs, "most queued and running jobs; more are refused (429)")
+      ->check(CLI::PositiveNumber)->capture_default_str()->group(limits);
+
+  auto* logging = "Logging";
+  app.add_option("--log-format", o.log_format, "text, or json: one JSON object per line")
+      ->check(CLI::IsMember({"text", "json"}))->capture_default_str()->group(logging);
+  app.add_option("--log-level", o.log_level, "debug (every lease), info (every job), warn or error")
+      ->check(CLI::IsMember({"debug", "info", "warn", "error"}))->capture_default_str()->group(logging);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  // Long polls may hold at most half the HTTP threads; the rest always serve clients.
+  c.max_waiting_polls = std::max(1, o.http_threads / 2);
+  return -1;
+}
+
+}  // namespace tessera::server
