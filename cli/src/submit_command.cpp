@@ -85,6 +85,35 @@ json wait_for(const farm::FarmClient& client, uint64_t id, bool quiet) {
   }
 }
 
+
+// "frame_####.png" with frame 7 -> "frame_0007.png" (the run of '#' sets the width).
+std::string frame_path(const std::string& pattern, int frame) {
+  const size_t a = pattern.find('#');
+  if (a == std::string::npos) return pattern;
+  size_t b = a;
+  while (b < pattern.size() && pattern[b] == '#') ++b;
+  std::string n = std::to_string(frame);
+  if (n.size() < b - a) n.insert(0, b - a - n.size(), '0');
+  return pattern.substr(0, a) + n + pattern.substr(b);
+}
+
+// Waits for one job and downloads its outputs; the exit code.
+int finish_job(const farm::FarmClient& client, uint64_t id, const std::vector<std::string>& outputs, bool quiet) {
+  json final_status = wait_for(client, id, quiet);
+  if (final_status.is_null()) return 1;
+  if (final_status.value("state", "") != "done") {
+    std::cerr << "job " << id << " " << final_status.value("state", "") << ": " << final_status.value("error", "")
+              << "\n";
+    return 1;
+  }
+  std::cerr << "job " << id << " done in " << final_status.value("elapsed_seconds", 0.0) << " s";
+  if (final_status.value("stopped_at_target", false))
+    std::cerr << ", stopped at " << final_status.value("spp_done", 0) << " spp (estimated relMSE "
+              << final_status.value("noise_estimate", 0.0) << ")";
+  std::cerr << "\n";
+  return download_outputs(client, id, outputs) ? 0 : 1;
+}
+
 }  // namespace
 
 int run_submit(const SubmitOptions& o) {
@@ -92,6 +121,10 @@ int run_submit(const SubmitOptions& o) {
     std::string ext = extension_of(out);
     if (ext != "exr" && ext != "png" && ext != "pfm") {
       std::cerr << "tessera submit: output '" << out << "': unknown format (use .exr, .pfm or .png)\n";
+      return 2;
+    }
+    if (!o.frames.empty() && out.find('#') == std::string::npos) {
+      std::cerr << "tessera submit: with --frames, output '" << out << "' needs '#'s for the frame number\n";
       return 2;
     }
   }
@@ -113,6 +146,8 @@ int run_submit(const SubmitOptions& o) {
   settings.defines = o.defines;
   settings.integrator = o.integrator;
   settings.light_selection = o.light_selection;
+  settings.target_error = o.target_error;
+  settings.webhook = o.webhook;
 
   std::string bundle;
   try {
@@ -129,11 +164,25 @@ int run_submit(const SubmitOptions& o) {
   }
   json body = to_json(settings);
   body.erase("scene");
+  if (!o.frames.empty()) body["frames"] = o.frames;
   farm::HttpReply r = client.post_job_with_bundle(body, bundle);
   json j = r.json();
   if (!r.ok() || !j.is_object()) {
     std::cerr << "tessera submit: the coordinator refused the job: " << r.describe() << "\n";
     return 1;
+  }
+  if (!o.frames.empty()) {
+    for (const json& job : j["jobs"]) std::cout << job.value("id", uint64_t(0)) << "\n";
+    std::cerr << j["jobs"].size() << " frame jobs submitted to " << client.url() << "\n";
+    if (!o.wait && o.outputs.empty()) return 0;
+    int code = 0;
+    for (const json& job : j["jobs"]) {
+      const int frame = std::stoi(job["settings"]["defines"].value("frame", "0"));
+      std::vector<std::string> outs;
+      for (const auto& out : o.outputs) outs.push_back(frame_path(out, frame));
+      code = std::max(code, finish_job(client, job.value("id", uint64_t(0)), outs, o.quiet));
+    }
+    return code;
   }
   const uint64_t id = j.value("id", uint64_t(0));
   std::cout << id << "\n";
@@ -141,15 +190,7 @@ int run_submit(const SubmitOptions& o) {
             << j.value("height", 0) << ", " << j.value("spp", 0) << " spp, " << j.value("tiles", 0) << " tiles x "
             << j.value("passes", 0) << " passes\n";
   if (!o.wait && o.outputs.empty()) return 0;
-  json final_status = wait_for(client, id, o.quiet);
-  if (final_status.is_null()) return 1;
-  if (final_status.value("state", "") != "done") {
-    std::cerr << "job " << id << " " << final_status.value("state", "") << ": " << final_status.value("error", "")
-              << "\n";
-    return 1;
-  }
-  std::cerr << "job " << id << " done in " << final_status.value("elapsed_seconds", 0.0) << " s\n";
-  return download_outputs(client, id, o.outputs) ? 0 : 1;
+  return finish_job(client, id, o.outputs, o.quiet);
 }
 
 int run_jobs(const JobsOptions& o) {
@@ -165,7 +206,8 @@ int run_jobs(const JobsOptions& o) {
   for (const json& job : j["jobs"])
     std::printf("%6llu  %-10s %6d %8.1f%% %5dx%-5d %6d  %s\n", (unsigned long long)job.value("id", uint64_t(0)),
                 job.value("state", "").c_str(), job.value("priority", 0), 100.0 * job.value("progress", 0.0),
-                job.value("width", 0), job.value("height", 0), job.value("spp", 0), job.value("name", "").c_str());
+                job.value("width", 0), job.value("height", 0),
+                job.value("stopped_at_target", false) ? job.value("spp_done", 0) : job.value("spp", 0), job.value("name", "").c_str());
   return 0;
 }
 

@@ -1,5 +1,6 @@
 // Construction, resume after a restart, lease expiry, health and shutdown.
 #include "coordinator_impl.h"
+#include "disk_full.h"
 #include "event_log.h"
 
 #include "tessera/farm/tile_result.h"
@@ -18,8 +19,7 @@ double wall_seconds() {
 }
 
 Status internal_error(const std::exception& e) {
-  if (auto* se = dynamic_cast<const StoreError*>(&e); se && se->disk_full)
-    return make_error(Code::InsufficientStorage, "disk_full", se->what());
+  if (is_disk_full(e)) return disk_full_status(e);
   return make_error(Code::Internal, "internal", e.what());
 }
 
@@ -74,14 +74,25 @@ Coordinator::Coordinator(CoordinatorOptions options) : impl_(std::make_unique<Im
       s.store.for_each_result(row.id, [&](ResultRow&& r) {
         if (r.tile < job->num_tiles() && r.pass < job->num_passes()) job->mark_done(job->unit(r.tile, r.pass), r.worker);
       }, /*with_data=*/false);
+      if (job->phase == JobPhase::Done && job->done_units() < job->num_units()) job->restore_converged();
       job->release_film();
       s.jobs.emplace(row.id, std::move(job));
       continue;
     }
     auto job = s.rebuild_job(row);
     passes += job->done_units();
+    const bool completed_now = !is_terminal(job->phase) && job->complete();  // its last result landed before a crash
+    if (completed_now) {
+      job->phase = JobPhase::Done;
+      job->finished = wall_seconds();
+    }
     if (!is_terminal(job->phase)) ++resumed;
-    else s.save_phase(*job);  // ended before its image was written
+    else try {
+      s.save_phase(*job, /*notify=*/completed_now);  // (else it ended before its image was written)
+    } catch (const StoreError& e) {  // a full disk: the image is retried by the retention pass
+      if (!e.disk_full) throw;
+      spdlog::warn("job {}: {}", row.id, e.what());
+    }
     s.jobs.emplace(row.id, std::move(job));
   }
   if (!s.jobs.empty())
@@ -138,23 +149,35 @@ std::string Coordinator::Impl::image_path(uint64_t job) const {
   return (fs::path(opt.data_dir) / "images" / (std::to_string(job) + ".exr")).string();
 }
 
-void Coordinator::Impl::save_phase(JobState& job) {
+void Coordinator::Impl::save_phase(JobState& job, bool notify) {
   store.set_job_state(job.id(), phase_name(job.phase), job.error, job.started, job.finished);
   if (is_terminal(job.phase) && job.has_film()) {
     const std::string path = image_path(job.id());
-    write_image(path + ".tmp.exr", job.image(),
+    write_image_durably(path, job.image(),
                 {{"tessera_version", TESSERA_VERSION}, {"tessera_job", std::to_string(job.id())},
-                 {"tessera_spp", std::to_string(job.plan().settings.spp)},
-                 {"tessera_seed", std::to_string(job.plan().settings.seed)}});
-    fs::rename(path + ".tmp.exr", path);
+                 {"tessera_spp", std::to_string(job.converged() ? job.spp_complete() : uint32_t(job.plan().settings.spp))},
+                 {"tessera_seed", std::to_string(job.plan().settings.seed)}}, opt.data_dir);
     job.release_film();
   }
+  if (notify && is_terminal(job.phase) && !job.plan().settings.webhook.empty())
+    webhooks.send(job.id(), job.plan().settings.webhook, status_json(job).dump());
 }
 
 void Coordinator::Impl::reap_loop() {
   std::unique_lock<std::mutex> lock(mu);
+  auto next_retention = Clock::now();  // a pass at start-up, then every maintenance_interval (retention.h)
   while (!stopping) {
     work_cv.wait_for(lock, std::chrono::milliseconds(250));
+    if (opt.maintenance_interval > 0 && Clock::now() >= next_retention && !stopping) {
+      lock.unlock();
+      try {
+        (void)run_retention(wall_seconds());
+      } catch (const std::exception& e) {
+        spdlog::warn("retention pass failed: {}", e.what());
+      }
+      lock.lock();
+      next_retention = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(opt.maintenance_interval));
+    }
     const auto now = Clock::now();
     for (auto it = leases.begin(); it != leases.end();) {
       auto next = std::next(it);
@@ -207,6 +230,10 @@ std::string Coordinator::metrics() {
   out += metric_header("tessera_bytes_total", "counter", "Payload bytes received (bundles, results) and sent (leases, bundles, images).");
   out += "tessera_bytes_total{direction=\"in\"} " + std::to_string(c.bytes_in) + "\n";
   out += "tessera_bytes_total{direction=\"out\"} " + std::to_string(c.bytes_out) + "\n";
+  out += metric_header("tessera_webhooks_total", "counter", "Job webhooks delivered and given up on.");
+  out += "tessera_webhooks_total{result=\"delivered\"} " + std::to_string(s.webhooks.delivered()) + "\n";
+  out += "tessera_webhooks_total{result=\"failed\"} " + std::to_string(s.webhooks.failed()) + "\n";
+  out += retention_metrics(s.retention);
   return out;
 }
 

@@ -4,6 +4,8 @@
 
 #include "job_state.h"
 #include "metrics.h"
+#include "retention.h"
+#include "webhooks.h"
 #include "tessera/farm/build_fingerprint.h"
 #include "tessera/server/coordinator.h"
 #include "tessera/server/store.h"
@@ -54,6 +56,8 @@ struct Coordinator::Impl {
     uint64_t leased = 0, done = 0, expired = 0, failed = 0, duplicates = 0, bytes_in = 0, bytes_out = 0;
   } counters;
   Histogram lease_wait{{0.001, 0.01, 0.1, 0.5, 1, 2.5, 5, 10, 20, 30}};
+  WebhookSender webhooks;
+  RetentionState retention;  // (under `mu`)
   Histogram upload_seconds{{0.0005, 0.001, 0.0025, 0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 1}};
 
   std::string bundle_path(const std::string& hash) const;
@@ -62,8 +66,9 @@ struct Coordinator::Impl {
   WorkerInfo* find_worker(uint64_t id);
   /// Under `mu`: ends a lease (the unit becomes available again unless done).
   void end_lease(std::map<uint64_t, LeaseInfo>::iterator it);
-  /// Under `mu`: persists a job's phase; a job that ended writes its image and drops its film.
-  void save_phase(JobState& job);
+  /// Under `mu`: persists a job's phase; a job that ended writes its image, drops its film and
+  /// (with `notify`) has its webhook called.
+  void save_phase(JobState& job, bool notify = true);
   std::string image_path(uint64_t job) const;
   /// A job from its row (plan, phase, times), with no results yet.
   std::unique_ptr<JobState> job_from_row(const JobRow& row) const;
@@ -75,6 +80,10 @@ struct Coordinator::Impl {
   nlohmann::json status_json(const JobState& job);
   /// Expires leases and marks silent workers lost, once a second.
   void reap_loop();
+  /// A retention pass (retention.cpp); takes `mu` itself and deletes files outside it.
+  nlohmann::json run_retention(double now);
+  /// Under `mu`: 404 for a job that is not (or no longer) here, saying so if retention deleted it.
+  Status missing_job(uint64_t id);
 };
 
 double wall_seconds();

@@ -1,6 +1,7 @@
 // Scenes and jobs: upload, submit (the scene is loaded here, so a broken one fails the request),
 // status, image, cancel.
 #include "coordinator_impl.h"
+#include "disk_full.h"
 #include "event_log.h"
 
 #include "tessera/farm/sha256.h"
@@ -12,6 +13,8 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -27,9 +30,9 @@ namespace {
 // Written to a temporary name, fsync'd, renamed, directory fsync'd: after a crash the file is
 // either complete or absent.
 void write_file_durably(const std::string& path, const std::string& bytes) {
-  const std::string tmp = path + ".tmp";
+  const std::string tmp = path + ".tmp", data_dir = fs::path(path).parent_path().parent_path().string();
   int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) throw StoreError("cannot create " + tmp + ": " + std::strerror(errno), errno == ENOSPC);
+  if (fd < 0) throw_write_error("cannot create " + tmp, errno, data_dir);
   size_t off = 0;
   while (off < bytes.size()) {
     ssize_t n = ::write(fd, bytes.data() + off, bytes.size() - off);
@@ -37,14 +40,14 @@ void write_file_durably(const std::string& path, const std::string& bytes) {
       int err = errno;
       ::close(fd);
       ::unlink(tmp.c_str());
-      throw StoreError("cannot write " + tmp + ": " + std::strerror(err), err == ENOSPC);
+      throw_write_error("cannot write " + tmp, err, data_dir);
     }
     off += size_t(n);
   }
   if (::fsync(fd) != 0 || ::close(fd) != 0) {
     int err = errno;
     ::unlink(tmp.c_str());
-    throw StoreError("cannot sync " + tmp + ": " + std::strerror(err), err == ENOSPC);
+    throw_write_error("cannot sync " + tmp, err, data_dir);
   }
   fs::rename(tmp, path);
   int dir = ::open(fs::path(path).parent_path().c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
@@ -96,7 +99,7 @@ Result<json> Coordinator::upload_scene(const std::string& bundle) {
   if (!inspected.ok()) return make_error(Code::BadRequest, "bad_bundle", inspected.error);
   const std::string hash = sha256_hex(bundle);
   try {
-    if (!fs::exists(s.bundle_path(hash))) write_file_durably(s.bundle_path(hash), bundle);
+    if (!touch_bundle(s.bundle_path(hash))) write_file_durably(s.bundle_path(hash), bundle);
     std::lock_guard<std::mutex> lock(s.mu);
     s.store.add_scene(hash, bundle.size(), wall_seconds());
     s.counters.bytes_in += bundle.size();
@@ -111,7 +114,7 @@ Result<json> Coordinator::upload_scene(const std::string& bundle) {
 Result<std::string> Coordinator::scene_bundle_path(const std::string& hash) {
   if (!is_sha256_hex(hash)) return make_error(Code::BadRequest, "bad_hash", "'" + hash + "' is not a SHA-256 hash");
   std::string path = impl_->bundle_path(hash);
-  if (!fs::exists(path)) return make_error(Code::NotFound, "unknown_scene", "no scene bundle " + hash);
+  if (!touch_bundle(path)) return make_error(Code::NotFound, "unknown_scene", "no scene bundle " + hash);
   return path;
 }
 
@@ -128,12 +131,91 @@ Result<std::string> Coordinator::scene_bundle(const std::string& hash) {
   }
 }
 
+namespace {
+
+// "12-20", "12..20", "7" or [12, 20]: an inclusive range, at most `max_frames` long.
+bool parse_frames(const json& j, int& first, int& last, size_t max_frames, std::string& error) {
+  try {
+    if (j.is_array() && j.size() == 2 && j[0].is_number_integer() && j[1].is_number_integer()) {
+      first = j[0].get<int>();
+      last = j[1].get<int>();
+    } else if (j.is_number_integer()) {
+      first = last = j.get<int>();
+    } else if (j.is_string()) {
+      const std::string s = j.get<std::string>();
+      size_t cut = s.find("..");
+      size_t skip = 2;
+      if (cut == std::string::npos) cut = s.find('-', 1), skip = 1;
+      size_t used = 0;
+      first = std::stoi(s.substr(0, cut), &used);
+      if (used != (cut == std::string::npos ? s.size() : cut)) throw std::invalid_argument("trailing characters");
+      last = first;
+      if (cut != std::string::npos) {
+        const std::string rest = s.substr(cut + skip);
+        last = std::stoi(rest, &used);
+        if (used != rest.size()) throw std::invalid_argument("trailing characters");
+      }
+    } else {
+      throw std::invalid_argument("type");
+    }
+  } catch (const std::exception&) {
+    error = "job settings: field 'frames' must be \"FIRST-LAST\", \"FIRST..LAST\", a frame number or [FIRST, LAST]";
+    return false;
+  }
+  if (last < first || uint64_t(int64_t(last) - first) >= max_frames) {
+    error = "job settings: frames " + std::to_string(first) + ".." + std::to_string(last) + " is not a range of 1.." +
+            std::to_string(max_frames) + " frames";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+Result<json> Coordinator::submit_frames(const json& body, const std::string& bundle) {
+  Impl& s = *impl_;
+  int first = 0, last = 0;
+  std::string error;
+  if (!parse_frames(body["frames"], first, last, size_t(std::max(1, s.opt.max_active_jobs)), error))
+    return make_error(Code::BadRequest, "bad_settings", error);
+  json base = body;
+  base.erase("frames");
+  if (!bundle.empty()) {
+    Result<json> uploaded = upload_scene(bundle);
+    if (!uploaded.ok()) return uploaded.status;
+    base["scene"] = uploaded.value["hash"];
+  }
+  if (!base.contains("defines") || !base["defines"].is_object()) base["defines"] = json::object();
+  const std::string name = base.value("name", std::string("frames"));
+  json jobs = json::array();
+  for (int frame = first; frame <= last; ++frame) {
+    json one = base;
+    one["defines"]["frame"] = std::to_string(frame);
+    one["name"] = name + " frame " + std::to_string(frame);
+    Result<json> r = submit_job(one, "");
+    if (!r.ok()) {
+      for (const json& j : jobs) (void)cancel_job(j["id"].get<uint64_t>());
+      r.status.detail = "frame " + std::to_string(frame) + ": " + r.status.detail +
+                        (jobs.empty() ? "" : " (the " + std::to_string(jobs.size()) + " frame(s) queued before were cancelled)");
+      return r.status;
+    }
+    jobs.push_back(std::move(r.value));
+  }
+  return json{{"jobs", jobs}, {"frames", {first, last}}};
+}
+
 Result<json> Coordinator::submit_job(const json& body, const std::string& bundle) {
   Impl& s = *impl_;
+  if (body.is_object() && body.contains("frames")) return submit_frames(body, bundle);
   JobSettings settings;
   std::string error;
   if (!job_settings_from_json(body, settings, error, bundle.empty()))
     return make_error(Code::BadRequest, "bad_settings", error);
+  if (!settings.webhook.empty() && !s.opt.webhook_allow.empty() &&
+      std::none_of(s.opt.webhook_allow.begin(), s.opt.webhook_allow.end(),
+                   [&](const std::string& prefix) { return settings.webhook.rfind(prefix, 0) == 0; }))
+    return make_error(Code::Unprocessable, "webhook_not_allowed",
+                      "webhook '" + settings.webhook + "' does not start with any --webhook-allow prefix");
   {
     std::lock_guard<std::mutex> lock(s.mu);
     if (Status st = s.check_active_jobs(); !st.ok()) return st;
@@ -159,6 +241,7 @@ Result<json> Coordinator::submit_job(const json& body, const std::string& bundle
           if (e.is_regular_file()) entries.push_back({e.path().lexically_relative(dir).generic_string(), e.file_size()});
       } else {
         BundleResult unpacked = unpack_bundle(read_file(path.value), dir, s.opt.bundle_limits);
+        throw_if_disk_full(unpacked.error, s.opt.data_dir);
         if (!unpacked.ok()) return make_error(Code::BadRequest, "bad_bundle", unpacked.error);
         entries = std::move(unpacked.files);
       }
@@ -171,6 +254,8 @@ Result<json> Coordinator::submit_job(const json& body, const std::string& bundle
     return make_error(Code::Unprocessable, "scene_unsupported", strip_dir(e.what(), dir));
   } catch (const SceneError& e) {
     return make_error(Code::Unprocessable, "scene_load_failed", strip_dir(e.what(), dir));
+  } catch (const DiskFullError& e) {
+    return internal_error(e);
   } catch (const std::exception& e) {
     return make_error(Code::Unprocessable, "scene_load_failed", strip_dir(e.what(), dir));
   }
@@ -223,7 +308,7 @@ json Coordinator::Impl::status_json(const JobState& job) {
             {"tiles", job.num_tiles()},
             {"passes", job.num_passes()},
             {"units_done", job.done_units()},
-            {"units_total", job.num_units()},
+            {"units_total", job.planned_units()},
             {"samples_done", job.done_samples()},
             {"samples_total", job.total_samples()},
             {"progress", fraction},
@@ -235,6 +320,14 @@ json Coordinator::Impl::status_json(const JobState& job) {
             {"result_bytes", job.result_bytes},
             {"lease_bytes", job.lease_bytes},
             {"nonfinite_samples", job.counters().nonfinite}};
+  // Speed and noise: samples/s over the job's running time, and the estimated relMSE of the image
+  // now (noise_estimate.h; null until every pixel has two samples).
+  j["samples_per_second"] = elapsed > 0 ? double(job.done_samples()) / elapsed : 0.0;
+  const NoiseEstimate noise = job.noise();
+  j["noise_estimate"] = std::isfinite(noise.rel_mse) ? json(noise.rel_mse) : json(nullptr);
+  j["target_error"] = p.settings.target_error;
+  j["spp_done"] = job.spp_complete();
+  j["stopped_at_target"] = job.converged();
   try {
     j["leases_issued"] = store.leases_issued(job.id());
     j["reissued_acknowledged_passes"] = store.reissued_after_ack(job.id());
@@ -246,7 +339,7 @@ json Coordinator::Impl::status_json(const JobState& job) {
 Result<json> Coordinator::job_status(uint64_t id) {
   std::lock_guard<std::mutex> lock(impl_->mu);
   auto it = impl_->jobs.find(id);
-  if (it == impl_->jobs.end()) return unknown_job(id);
+  if (it == impl_->jobs.end()) return impl_->missing_job(id);
   return impl_->status_json(*it->second);
 }
 
@@ -278,7 +371,7 @@ Result<ImageBytes> Coordinator::job_image(uint64_t id, const std::string& format
   {
     std::lock_guard<std::mutex> lock(s.mu);
     auto it = s.jobs.find(id);
-    if (it == s.jobs.end()) return unknown_job(id);
+    if (it == s.jobs.end()) return s.missing_job(id);
     plan = it->second->plan();
     if (it->second->has_film()) image = it->second->image();
   }
@@ -308,6 +401,7 @@ Result<ImageBytes> Coordinator::job_image(uint64_t id, const std::string& format
                    {"tessera_spp", std::to_string(plan.settings.spp)},
                    {"tessera_seed", std::to_string(plan.settings.seed)}});
     }
+    verify_image_file(tmp, format, image, s.opt.data_dir);  // (a full disk can truncate it silently)
     ImageBytes out{read_file(tmp), format == "png" ? "image/png" : format == "exr" ? "image/x-exr" : "image/x-pfm"};
     fs::remove(tmp);
     std::lock_guard<std::mutex> lock(s.mu);

@@ -97,6 +97,20 @@ Result<json> Coordinator::lease(uint64_t worker, double wait_seconds) {
     if (best) {
       try {
         const double now = wall_seconds();
+        // The job's first lease: persisted before anything is recorded in memory, so a failed write
+        // (a full disk) leaves no lease behind that would hold the unit until it expires.
+        if (best->phase == JobPhase::Queued) {
+          best->phase = JobPhase::Running;
+          best->started = now;
+          try {
+            s.save_phase(*best);
+          } catch (...) {
+            best->phase = JobPhase::Queued;
+            best->started = 0;
+            throw;
+          }
+          log_event(spdlog::level::info, "job.started", {{"job", best->id()}});
+        }
         Lease l;
         l.id = s.store.log_lease(best->id(), best->tile_of(unit), best->pass_of(unit), worker, now);
         l.job_id = best->id();
@@ -113,12 +127,6 @@ Result<json> Coordinator::lease(uint64_t worker, double wait_seconds) {
         s.leases[l.id] = LeaseInfo{l.id, l.job_id, worker, unit,
                                    Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                                       std::chrono::duration<double>(s.opt.lease_timeout))};
-        if (best->phase == JobPhase::Queued) {
-          best->phase = JobPhase::Running;
-          best->started = now;
-          s.save_phase(*best);
-          log_event(spdlog::level::info, "job.started", {{"job", best->id()}});
-        }
         w->state = "busy";
         json j = to_json(l);
         const size_t bytes = j.dump().size();
@@ -246,7 +254,7 @@ Result<json> Coordinator::upload_result(uint64_t worker, uint64_t lease, std::st
   w->units_done += 1;
   w->samples_done += samples;
   w->render_seconds += result.seconds;
-  if (job.done_units() == job.num_units()) {
+  if (job.complete()) {
     job.phase = JobPhase::Done;
     job.finished = wall_seconds();
     try {
@@ -254,7 +262,9 @@ Result<json> Coordinator::upload_result(uint64_t worker, uint64_t lease, std::st
     } catch (const std::exception& e) {
       return internal_error(e);
     }
-    log_event(spdlog::level::info, "job.done", {{"job", job.id()}, {"seconds", job.finished - job.started}});
+    log_event(spdlog::level::info, "job.done",
+              {{"job", job.id()}, {"seconds", job.finished - job.started}, {"spp", job.spp_complete()},
+               {"stopped_at_target", job.converged()}});
   }
   (void)lease;
   s.upload_seconds.observe(std::chrono::duration<double>(Clock::now() - t0).count());

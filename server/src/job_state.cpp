@@ -2,6 +2,8 @@
 
 #include "tessera/render/renderer.h"
 
+#include <limits>
+
 namespace tessera::server {
 
 const char* phase_name(JobPhase p) {
@@ -39,10 +41,37 @@ JobState::JobState(uint64_t id, JobPlan plan, std::string name, int priority, do
   active_leases_.assign(num_units(), 0);
   next_pass_.assign(tiles_.size(), 0);
   total_samples_ = uint64_t(plan_.window.area()) * uint64_t(plan_.settings.spp);
+  pass_done_.assign(passes_.size(), 0);
+  open_passes_ = plan_.settings.target_error > 0 ? std::min<size_t>(1, passes_.size()) : passes_.size();
+}
+
+NoiseEstimate JobState::noise() const {
+  if (!film_) return noise_ ? *noise_ : NoiseEstimate{std::numeric_limits<double>::infinity(), 0};
+  if (!noise_ || noise_units_ != done_units_) {
+    noise_ = estimate_noise(*film_);
+    noise_units_ = done_units_;
+  }
+  return *noise_;
+}
+
+void JobState::advance_passes() {
+  while (complete_passes_ < passes_.size() && pass_done_[complete_passes_] == tiles_.size()) ++complete_passes_;
+  while (!converged_ && open_passes_ < passes_.size() && complete_passes_ >= open_passes_) {
+    // A unit of the next pass is done already: the decision to go on was taken before a restart.
+    bool decided = false;
+    for (size_t t = 0; t < tiles_.size() && !decided; ++t) decided = done_[unit(uint32_t(t), uint32_t(open_passes_))];
+    if (!decided && film_ && noise().rel_mse <= plan_.settings.target_error) {
+      converged_ = true;
+      break;
+    }
+    ++open_passes_;
+  }
 }
 
 std::optional<size_t> JobState::next_unit() const {
-  for (size_t u = first_open_; u < done_.size(); ++u)
+  if (converged_) return std::nullopt;
+  const size_t open_end = open_passes_ * tiles_.size();
+  for (size_t u = first_open_; u < open_end; ++u)
     if (!done_[u] && active_leases_[u] == 0) return u;
   return std::nullopt;
 }
@@ -55,6 +84,7 @@ void JobState::mark_done(size_t unit, uint64_t worker) {
   if (done_[unit]) return;
   done_[unit] = 1;
   ++done_units_;
+  ++pass_done_[pass_of(unit)];
   done_samples_ += unit_samples(unit);
   samples_by_worker_[worker] += unit_samples(unit);
   while (first_open_ < done_.size() && done_[first_open_]) ++first_open_;
@@ -77,6 +107,7 @@ bool JobState::add_result(size_t unit, FilmTile&& tile, uint64_t worker) {
     waiting_.erase(it);
     if (++next_pass_[t] == passes_.size()) break;
   }
+  advance_passes();
   return true;
 }
 

@@ -5,6 +5,7 @@
 #include "tessera/farm/job_scene.h"
 #include "tessera/image/image.h"
 #include "tessera/render/film.h"
+#include "tessera/render/noise_estimate.h"
 
 #include <cstdint>
 #include <map>
@@ -43,8 +44,25 @@ class JobState {
   uint32_t sample_end(size_t unit) const { return pass_begin_[pass_of(unit)] + passes_[pass_of(unit)]; }
   /// Samples (pixels x samples per pixel) of the unit: the weight of its work.
   uint64_t unit_samples(size_t unit) const { return uint64_t(rect(unit).area()) * (sample_end(unit) - sample_begin(unit)); }
-  uint64_t total_samples() const { return total_samples_; }
+  /// The samples the job will render: all of spp, or those done once it stopped at its target.
+  uint64_t total_samples() const { return converged_ ? done_samples_ : total_samples_; }
   uint64_t done_samples() const { return done_samples_; }
+  /// Units the job will render (fewer than num_units() once it stopped at its target error).
+  size_t planned_units() const { return converged_ ? done_units_ : num_units(); }
+  /// Every planned unit is done.
+  bool complete() const { return converged_ || done_units_ == num_units(); }
+
+  // Target error (settings.target_error > 0): pass p+1 is leased only once every tile has pass p
+  // and the estimate over exactly those passes is above the target. The decision depends on the
+  // film of passes 0..p alone, so it is the same however the tiles were rendered, and the same
+  // again when the job is rebuilt from its results after a restart.
+  bool converged() const { return converged_; }
+  /// Samples per pixel of the passes every tile has.
+  uint32_t spp_complete() const { return complete_passes_ ? pass_begin_[complete_passes_ - 1] + passes_[complete_passes_ - 1] : 0; }
+  /// The estimate over the film now (cached until the next result); +inf before 2 samples a pixel.
+  NoiseEstimate noise() const;
+  /// A finished job resumed without its film that had stopped at its target.
+  void restore_converged() { converged_ = true; }
 
   /// The first unit, pass-major, that is neither done nor leased and that `worker` may take.
   std::optional<size_t> next_unit() const;
@@ -63,6 +81,7 @@ class JobState {
   /// sums); the image is then served from the file.
   bool has_film() const { return film_ != nullptr; }
   void release_film() {
+    if (film_) (void)noise();  // kept for the finished job's status
     film_.reset();
     waiting_.clear();
   }
@@ -93,7 +112,15 @@ class JobState {
   std::vector<uint16_t> active_leases_;
   std::vector<uint32_t> next_pass_;              // per tile: passes already in the film
   std::map<size_t, FilmTile> waiting_;           // results that arrived before an earlier pass
+  void advance_passes();
+
   size_t done_units_ = 0, first_open_ = 0;
+  std::vector<uint32_t> pass_done_;  // per pass: tiles that have it
+  size_t open_passes_ = 0;           // passes that may be leased
+  size_t complete_passes_ = 0;       // passes every tile has
+  bool converged_ = false;
+  mutable std::optional<NoiseEstimate> noise_;  // for done_units_ == noise_units_
+  mutable size_t noise_units_ = 0;
   uint64_t total_samples_ = 0, done_samples_ = 0;
   std::map<uint64_t, uint64_t> samples_by_worker_;
   std::unique_ptr<Film> film_;

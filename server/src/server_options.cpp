@@ -52,6 +52,17 @@ int parse_server_args(int argc, char** argv, ServerOptions& o) {
   app.add_option("--max-active-jobs", c.max_active_jobs, "most queued and running jobs; more are refused (429)")
       ->check(CLI::PositiveNumber)->capture_default_str()->group(limits);
 
+  app.add_option("--webhook-allow", c.webhook_allow, "URL prefix a job's webhook must start with (repeatable; default: any)")
+      ->group(security);
+
+  auto* retention = "Retention";
+  app.add_option("--retain-days", c.retain_days,
+                 "delete finished jobs (results, image) this many days after they ended, and bundles unused as long; 0: keep")
+      ->check(CLI::NonNegativeNumber)->capture_default_str()->group(retention);
+  app.add_option("--retain-bytes", c.retain_bytes,
+                 "above this many bytes of results, images and bundles, delete the oldest finished jobs first; 0: no limit")
+      ->capture_default_str()->group(retention);
+
   auto* logging = "Logging";
   app.add_option("--log-format", o.log_format, "text, or json: one JSON object per line")
       ->check(CLI::IsMember({"text", "json"}))->capture_default_str()->group(logging);

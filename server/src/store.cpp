@@ -2,6 +2,9 @@
 
 #include <sqlite3.h>
 
+#include <cerrno>
+#include <filesystem>
+
 namespace tessera::server {
 namespace {
 
@@ -19,11 +22,30 @@ CREATE INDEX IF NOT EXISTS leases_by_unit ON leases(job, pass, tile);
 CREATE TABLE IF NOT EXISTS workers(id INTEGER PRIMARY KEY AUTOINCREMENT, name TEXT NOT NULL, threads INTEGER NOT NULL,
   memory INTEGER NOT NULL, version TEXT NOT NULL, isa TEXT NOT NULL, registered REAL NOT NULL,
   last_seen REAL NOT NULL, state TEXT NOT NULL);
+CREATE TABLE IF NOT EXISTS expired_jobs(id INTEGER PRIMARY KEY, name TEXT NOT NULL, expired REAL NOT NULL);
 )";
 
+// SQLite reports a full disk as SQLITE_FULL, or as an I/O error whose errno is ENOSPC/EDQUOT
+// (a failed fsync or WAL write). Either way the statement's transaction was rolled back: the
+// database is as it was before, and the caller answers 507.
+bool disk_full(sqlite3* db) {
+  if (!db) return false;
+  const int code = sqlite3_errcode(db);
+  if (code == SQLITE_FULL) return true;
+  const int err = sqlite3_system_errno(db);
+  return code == SQLITE_IOERR && (err == ENOSPC || err == EDQUOT);
+}
+
+[[noreturn]] void throw_error(sqlite3* db, const std::string& msg) {
+  if (disk_full(db)) {
+    const char* file = sqlite3_db_filename(db, "main");
+    throw DiskFullError(msg, file ? std::filesystem::path(file).parent_path().string() : "");
+  }
+  throw StoreError(msg, false);
+}
+
 [[noreturn]] void fail(sqlite3* db, const std::string& what) {
-  int code = db ? sqlite3_errcode(db) : SQLITE_ERROR;
-  throw StoreError(what + ": " + (db ? sqlite3_errmsg(db) : "cannot open"), code == SQLITE_FULL);
+  throw_error(db, "state database: " + what + ": " + (db ? sqlite3_errmsg(db) : "cannot open"));
 }
 
 // A prepared statement that binds left to right and finalises itself.
@@ -83,6 +105,9 @@ Store::Store(const std::string& path) {
     throw StoreError(msg, false);
   }
   sqlite3_busy_timeout(db_, 5000);
+  // Only takes effect in a new database (before its first table): pages freed by retention then
+  // go back to the file system at incremental_vacuum(). Older databases reuse them instead.
+  exec("PRAGMA auto_vacuum=INCREMENTAL");
   // WAL keeps readers off the writer's back; FULL fsyncs the log at every commit, which is what
   // makes an acknowledged result survive a crash.
   exec("PRAGMA journal_mode=WAL");
@@ -97,7 +122,7 @@ void Store::exec(const char* sql) {
   if (sqlite3_exec(db_, sql, nullptr, nullptr, &err) != SQLITE_OK) {
     std::string msg = err ? err : "error";
     sqlite3_free(err);
-    throw StoreError(std::string("state database: ") + msg, sqlite3_errcode(db_) == SQLITE_FULL);
+    throw_error(db_, "state database: " + msg);
   }
 }
 
@@ -174,6 +199,49 @@ uint64_t Store::leases_issued(uint64_t job) {
   st.bind(int64_t(job)).step();
   return uint64_t(st.i(0));
 }
+
+std::vector<std::pair<uint64_t, uint64_t>> Store::result_bytes(const std::vector<uint64_t>& ids) {
+  std::vector<std::pair<uint64_t, uint64_t>> out;
+  if (ids.empty()) {
+    Stmt st(db_, "SELECT job, SUM(LENGTH(data)) FROM results GROUP BY job");
+    while (st.step()) out.emplace_back(uint64_t(st.i(0)), uint64_t(st.i(1)));
+    return out;
+  }
+  for (uint64_t id : ids) {
+    Stmt st(db_, "SELECT COALESCE(SUM(LENGTH(data)), 0) FROM results WHERE job = ?");
+    st.bind(int64_t(id)).step();
+    out.emplace_back(id, uint64_t(st.i(0)));
+  }
+  return out;
+}
+
+void Store::delete_job(uint64_t id, double now) {
+  exec("BEGIN IMMEDIATE");
+  try {
+    Stmt(db_, "INSERT OR REPLACE INTO expired_jobs(id, name, expired) SELECT id, name, ? FROM jobs WHERE id = ?")
+        .bind(now).bind(int64_t(id)).step();
+    Stmt(db_, "DELETE FROM results WHERE job = ?").bind(int64_t(id)).step();
+    Stmt(db_, "DELETE FROM leases WHERE job = ?").bind(int64_t(id)).step();
+    Stmt(db_, "DELETE FROM jobs WHERE id = ?").bind(int64_t(id)).step();
+    exec("COMMIT");
+  } catch (...) {
+    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+    throw;
+  }
+}
+
+std::optional<double> Store::expired_job(uint64_t id) {
+  Stmt st(db_, "SELECT expired FROM expired_jobs WHERE id = ?");
+  if (!st.bind(int64_t(id)).step()) return std::nullopt;
+  return st.d(0);
+}
+
+void Store::delete_scene(const std::string& hash) {
+  Stmt st(db_, "DELETE FROM scenes WHERE hash = ?");
+  st.bind(hash).step();
+}
+
+void Store::incremental_vacuum() { exec("PRAGMA incremental_vacuum"); }
 
 uint64_t Store::add_worker(const WorkerRow& w) {
   Stmt st(db_,

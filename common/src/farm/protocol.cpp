@@ -100,7 +100,8 @@ json to_json(const JobSettings& s) {
   json j = {{"name", s.name},   {"scene", s.scene},         {"scene_file", s.scene_file},
             {"spp", s.spp},     {"width", s.width},         {"height", s.height},
             {"seed", s.seed},   {"tile_size", s.tile_size}, {"priority", s.priority},
-            {"defines", s.defines}, {"integrator", s.integrator}, {"light_selection", s.light_selection}};
+            {"defines", s.defines}, {"integrator", s.integrator}, {"light_selection", s.light_selection},
+            {"target_error", s.target_error}, {"webhook", s.webhook}};
   return j;
 }
 
@@ -118,10 +119,21 @@ bool job_settings_from_json(const json& j, JobSettings& out, std::string& error,
   f.get_strings("defines", out.defines);
   f.get("integrator", out.integrator);
   f.get("light_selection", out.light_selection);
+  f.get("target_error", out.target_error);
+  f.get("webhook", out.webhook);
   f.finish();
   if (!f.ok()) return false;
   if (!out.scene.empty() && !is_sha256_hex(out.scene)) {
     error = "job settings: field 'scene' must be a bundle hash (64 lowercase hex digits)";
+    return false;
+  }
+  if (!(out.target_error >= 0 && out.target_error <= 1)) {
+    error = "job settings: field 'target_error' must be a relMSE in 0..1 (0: render every sample)";
+    return false;
+  }
+  if (!out.webhook.empty() && ((out.webhook.rfind("http://", 0) != 0 && out.webhook.rfind("https://", 0) != 0) ||
+                               out.webhook.size() > 2000)) {
+    error = "job settings: field 'webhook' must be an http:// or https:// URL";
     return false;
   }
   if (out.name.size() > 200) {

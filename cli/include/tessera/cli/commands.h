@@ -39,6 +39,9 @@ struct SubmitOptions {
   uint32_t seed = 0;
   std::map<std::string, std::string> defines;
   std::string integrator, light_selection, name;
+  double target_error = 0;           // stop at this estimated relMSE (spp is then the budget)
+  std::string webhook;               // URL the coordinator POSTs the job's status to when it ends
+  std::string frames;                // "A-B": one job per frame (-D frame=N); outputs carry ####
   bool wait = false, quiet = false;
 };
 

@@ -26,6 +26,10 @@ struct JobSettings {
   std::map<std::string, std::string> defines;
   std::string integrator;       // empty: the scene's
   std::string light_selection;  // empty: the default
+  /// > 0: stop once the estimated relMSE of the image (noise_estimate.h) is at most this, at a
+  /// pass boundary; `spp` is then the budget. The image equals `tessera render` at the spp reached.
+  double target_error = 0;
+  std::string webhook;          // http(s) URL POSTed the job's status when it ends; empty: none
 };
 
 /// Limits a job must respect (the coordinator's flags).

@@ -16,6 +16,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace tessera::server {
 
@@ -29,7 +30,17 @@ struct CoordinatorOptions {
   JobLimits limits;
   BundleLimits bundle_limits;
   uint64_t max_upload_bytes = uint64_t(4) << 30;
-  int max_active_jobs = 10000;  // queued + running; more are refused with 429 until some end
+  int max_active_jobs = 10000;
+  // Retention (retention.h): finished jobs older than this many days since they ended are deleted
+  // with their results and image; 0 keeps them forever.
+  double retain_days = 0;
+  // Above this many bytes of stored results, images and bundles, the oldest finished jobs (and
+  // bundles no job uses) are deleted until under; 0: no limit.
+  uint64_t retain_bytes = 0;
+  // Seconds between retention passes (which also retry images a full disk kept from being
+  // written); the first runs at start-up. 0: only on apply_retention().
+  double maintenance_interval = 60;
+  std::vector<std::string> webhook_allow;  // URL prefixes a job's webhook must start with; empty: any  // queued + running; more are refused with 429 until some end
 };
 
 struct ImageBytes {
@@ -53,6 +64,9 @@ class Coordinator {
   Result<std::string> scene_bundle(const std::string& hash);
 
   // Jobs. `bundle` non-empty: uploaded in the same request (the settings' scene may be empty).
+  // With "frames": "A-B" (or [A, B]) in the settings, one job per frame N in A..B, each with
+  // `-D frame=N` and its own image; the answer is {"jobs": [status, ...]}. A frame that fails to
+  // load cancels the frames already queued and names itself in the error.
   Result<nlohmann::json> submit_job(const nlohmann::json& settings, const std::string& bundle);
   Result<nlohmann::json> job_status(uint64_t id);
   Result<nlohmann::json> list_jobs();
@@ -83,11 +97,16 @@ class Coordinator {
   /// Prometheus text format: jobs and workers by state, passes leased/done/expired/failed,
   /// lease-wait and upload latency histograms, bytes in and out, per-worker samples/s.
   std::string metrics();
+  /// One retention pass now (as the reaper runs every maintenance_interval), judged at wall time
+  /// `now` (0: the real time; tests pass a later one instead of sleeping). Returns
+  /// {"deleted_jobs", "deleted_bundles", "freed_bytes", "data_bytes"}.
+  Result<nlohmann::json> apply_retention(double now = 0);
   /// Wakes every long poll and refuses new ones (503); called on SIGTERM.
   void shutdown();
 
  private:
   struct Impl;
+  Result<nlohmann::json> submit_frames(const nlohmann::json& settings, const std::string& bundle);
   std::unique_ptr<Impl> impl_;
 };
 

@@ -10,6 +10,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 struct sqlite3;
@@ -19,6 +20,13 @@ namespace tessera::server {
 struct StoreError : std::runtime_error {
   bool disk_full = false;
   StoreError(const std::string& what, bool full) : std::runtime_error(what), disk_full(full) {}
+};
+
+/// A write failed because the disk holding the data directory is full (ENOSPC, EDQUOT,
+/// SQLITE_FULL). Services answer 507 with the directory named; nothing half-written is kept.
+struct DiskFullError : StoreError {
+  std::string data_dir;
+  DiskFullError(const std::string& what, std::string dir) : StoreError(what, true), data_dir(std::move(dir)) {}
 };
 
 struct JobRow {
@@ -70,6 +78,19 @@ class Store {
   /// restart test reads).
   uint64_t reissued_after_ack(uint64_t job);
   uint64_t leases_issued(uint64_t job);
+
+  // Retention (retention.cpp): sizes, deletion of a finished job, tombstones for its id.
+  /// Bytes of stored result data per job (only the jobs in `ids`, or every job when empty).
+  std::vector<std::pair<uint64_t, uint64_t>> result_bytes(const std::vector<uint64_t>& ids = {});
+  /// Deletes a job's results, lease log and row in one transaction, leaving a tombstone (its id,
+  /// name and when it expired) so its status can say why it is gone.
+  void delete_job(uint64_t id, double now);
+  /// When job `id` was deleted by retention, if it was.
+  std::optional<double> expired_job(uint64_t id);
+  void delete_scene(const std::string& hash);
+  /// Returns freed pages to the file system (databases created with auto_vacuum=INCREMENTAL;
+  /// older ones keep their size and reuse the pages).
+  void incremental_vacuum();
 
   uint64_t add_worker(const WorkerRow& w);
   std::optional<WorkerRow> worker(uint64_t id);
