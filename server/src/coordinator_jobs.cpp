@@ -70,6 +70,8 @@ std::string read_file(const std::string& path) {
 std::string strip_dir(std::string msg, const std::string& dir) {
   for (const std::string& prefix : {fs::weakly_canonical(dir).string() + "/", dir + "/"})
     for (size_t at; (at = msg.find(prefix)) != std::string::npos;) msg.erase(at, prefix.size());
+  for (const std::string& root : {fs::weakly_canonical(dir).string(), dir})  // the folder itself
+    for (size_t at; (at = msg.find(root)) != std::string::npos;) msg.replace(at, root.size(), "<bundle>");
   return msg;
 }
 

@@ -142,6 +142,11 @@ Result<json> Coordinator::lease(uint64_t worker, double wait_seconds) {
       }
     }
     if (Clock::now() >= deadline) break;
+    if (w->state == "busy") {  // waiting for work with none in hand: idle, as the dashboard shows
+      bool holds = false;
+      for (auto& [id, l] : s.leases) holds |= l.worker == worker;
+      if (!holds) w->state = "idle";
+    }
     s.work_cv.wait_until(lock, deadline);
   }
   if (w->state == "busy") {  // (a draining worker keeps its state)

@@ -103,6 +103,7 @@ TEST_F(FarmApi, SceneThatFailsToLoadGetsTheLoadersMessage) {
                                                            "<string name=\"filename\" value=\"gone.obj\"/></shape></scene>")),
       422);
   EXPECT_NE(detail.find("gone.obj"), std::string::npos) << detail;
+  EXPECT_EQ(detail.find(farm_.dir().path.string()), std::string::npos) << "leaks the data dir: " << detail;
   // Two XML files and no choice.
   ArchiveBuilder two(ArchiveBuilder::Format::TarGz);
   two.file("a.xml", "<scene version=\"0.6.0\"/>").file("b.xml", "<scene version=\"0.6.0\"/>");

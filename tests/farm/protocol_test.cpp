@@ -28,6 +28,8 @@ TEST(Protocol, JobSettingsRoundTrip) {
   s.defines = {{"spp", "4"}, {"res", "hi"}};
   s.integrator = "volpath";
   s.light_selection = "power";
+  s.target_error = 0.005;
+  s.webhook = "https://ci.example/hooks/render?x=1";
   JobSettings back;
   std::string error;
   ASSERT_TRUE(job_settings_from_json(to_json(s), back, error)) << error;
@@ -44,6 +46,11 @@ TEST(Protocol, JobSettingsAreStrict) {
   EXPECT_NE(parse_error(json{{"scene", "ABC"}}).find("hash"), std::string::npos);
   EXPECT_NE(parse_error(json{{"spp", 3}}).find("missing field 'scene'"), std::string::npos);
   EXPECT_NE(parse_error(json::array()).find("JSON object"), std::string::npos);
+  EXPECT_NE(parse_error(json{{"scene", h}, {"target_error", -0.1}}).find("'target_error'"), std::string::npos);
+  EXPECT_NE(parse_error(json{{"scene", h}, {"target_error", 2}}).find("'target_error'"), std::string::npos);
+  EXPECT_NE(parse_error(json{{"scene", h}, {"target_error", "low"}}).find("'target_error'"), std::string::npos);
+  EXPECT_NE(parse_error(json{{"scene", h}, {"webhook", "file:///etc/passwd"}}).find("'webhook'"), std::string::npos);
+  EXPECT_NE(parse_error(json{{"scene", h}, {"webhook", 7}}).find("'webhook'"), std::string::npos);
   JobSettings s;
   std::string error;
   EXPECT_TRUE(job_settings_from_json(json{{"spp", 3}}, s, error, /*require_scene=*/false)) << error;
@@ -72,6 +79,15 @@ TEST(Protocol, LimitsNameTheField) {
   s.width = s.height = 30000;
   EXPECT_FALSE(check_job_limits(s, limits, error));
   EXPECT_NE(error.find("pixels"), std::string::npos);
+  // Tiles: 4096 x 4096 in 4-pixel tiles is 1M tiles, over a limit of 1000; 64-pixel tiles fit.
+  s = {};
+  s.width = s.height = 4096;
+  s.tile_size = 4;
+  limits.max_tiles = 1000;
+  EXPECT_FALSE(check_job_limits(s, limits, error));
+  EXPECT_NE(error.find("tiles"), std::string::npos) << error;
+  s.tile_size = 256;
+  EXPECT_TRUE(check_job_limits(s, limits, error)) << error;
 }
 
 TEST(Protocol, LeaseRoundTripAndCacheKey) {
