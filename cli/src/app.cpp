@@ -1,5 +1,6 @@
 // Command-line surface of `tessera` (CLI11). Only option parsing; each subcommand is a library call.
 #include "tessera/cli/commands.h"
+#include "tessera/cli/convergence.h"
 
 #include <CLI/CLI.hpp>
 
@@ -31,6 +32,9 @@ int main_entry(int argc, char** argv) {
                 "Output image(s): .exr, .pfm or .png (default: SCENE_STEM.exr in the current directory, "
                 "plus SCENE_STEM.png for an ldrfilm)");
   r->add_option("--spp", render.spp, "Samples per pixel (default: the scene's)")->check(CLI::PositiveNumber);
+  r->add_option("--target-error", render.target_error,
+                "Stop at a pass whose estimated relMSE is at most this (--spp is then the budget)")
+      ->check(CLI::Range(0.0, 1.0));
   r->add_option("--width", render.width, "Film width (default: the scene's)")->check(CLI::PositiveNumber);
   r->add_option("--height", render.height, "Film height (default: the scene's)")->check(CLI::PositiveNumber);
   r->add_option("--threads", render.threads, "Render threads (default: all cores)")->check(CLI::NonNegativeNumber);
@@ -60,6 +64,24 @@ int main_entry(int argc, char** argv) {
   br->add_option("--threads", rays.threads, "Threads (default: all cores)")->check(CLI::NonNegativeNumber);
   br->add_option("--repeat", rays.repeat, "Trace each set this often and report the median (default 1)")
       ->check(CLI::Range(1, 100));
+
+  ConvergenceOptions conv;
+  auto* bc = bench->add_subcommand("convergence", "relMSE against a reference as the budget grows, per strategy (CSV, SVG)");
+  bc->add_option("scene", conv.scene, "Scene file")->required()->check(CLI::ExistingFile);
+  bc->add_option("--reference", conv.reference, "Reference image (.exr/.pfm/.hdr) of the same size")->required()
+      ->check(CLI::ExistingFile);
+  bc->add_option("--spp", conv.spp, "Budgets, e.g. 1,2,4,8 (default 1..64 doubling)")->delimiter(',');
+  bc->add_option("--seconds", conv.seconds, "Then keep doubling spp until one render takes this long")
+      ->check(CLI::NonNegativeNumber);
+  bc->add_option("--strategy", conv.strategies, "Sampling strategies: mis, bsdf, nee (default mis)")->delimiter(',')
+      ->check(CLI::IsMember({"mis", "bsdf", "nee"}));
+  bc->add_option("--csv", conv.csv, "Write the measurements here");
+  bc->add_option("--plot", conv.plot, "Write an SVG plot here (log-log relMSE against seconds and spp)");
+  bc->add_option("--width", conv.width, "Film width (default: the scene's)")->check(CLI::PositiveNumber);
+  bc->add_option("--height", conv.height, "Film height (default: the scene's)")->check(CLI::PositiveNumber);
+  bc->add_option("--threads", conv.threads, "Render threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  bc->add_option("--seed", conv.seed, "Seed of the first budget (budget i uses seed + i)");
+  bc->add_flag("--allow-unsupported", conv.allow_unsupported, "Substitute documented fallbacks for unsupported plugins");
 
   CompareOptions compare;
   auto* cmp = app.add_subcommand("compare", "Error of an image against a reference (relMSE, means, z-scores)");
@@ -129,6 +151,7 @@ int main_entry(int argc, char** argv) {
     return run_render(render);
   }
   if (br->parsed()) return run_bench_rays(rays);
+  if (bc->parsed()) return run_bench_convergence(conv);
   if (cmp->parsed()) return run_compare(compare);
   return 2;
 }

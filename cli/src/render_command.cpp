@@ -42,11 +42,11 @@ std::vector<std::string> output_paths(const RenderOptions& options, const Scene&
   return outs;
 }
 
-void write_outputs(const RenderOptions& options, const Scene& scene, const Film& film) {
+void write_outputs(const RenderOptions& options, const Scene& scene, const Film& film, uint32_t spp) {
   Image image = film.to_image();
   ImageAttributes attributes = {{"tessera_version", TESSERA_VERSION},
                                 {"tessera_scene", options.scene},
-                                {"tessera_spp", std::to_string(scene.sampler.sample_count)},
+                                {"tessera_spp", std::to_string(spp)},
                                 {"tessera_seed", std::to_string(options.seed)}};
   for (const auto& out : output_paths(options, scene)) {
     std::string ext = lower_extension(out);
@@ -108,6 +108,7 @@ int run_render(const RenderOptions& options) {
     settings.seed = options.seed;
     settings.threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
     settings.tile_size = options.tile_size;
+    settings.target_error = options.target_error;
 
     const std::vector<uint32_t> passes = pass_schedule(uint32_t(settings.spp));
     Progress progress("render", !options.quiet);
@@ -123,7 +124,7 @@ int run_render(const RenderOptions& options) {
         },
         &stats);
     progress.finish();
-    write_outputs(options, scene, film);
+    write_outputs(options, scene, film, stats.spp_done);
 
     const auto& c = stats.counters;
     BvhStats bvh = scene.accel().stats();
@@ -139,6 +140,10 @@ int run_render(const RenderOptions& options) {
                  double(c.rays()) / std::max(stats.seconds, 1e-9));
     if (c.nonfinite > 0) std::fprintf(stderr, "; %llu NaN/Inf samples dropped", (unsigned long long)c.nonfinite);
     std::fprintf(stderr, "\n");
+    if (settings.target_error > 0)
+      std::fprintf(stderr, "target error %g: %s at %u spp, estimated relMSE %.4g\n", settings.target_error,
+                   stats.spp_done < uint32_t(settings.spp) ? "stopped" : "not reached, budget spent", stats.spp_done,
+                   stats.noise_estimate);
     return 0;
   } catch (const UnsupportedError& e) {
     std::cerr << "error: " << e.what() << "\n";

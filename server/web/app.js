@@ -230,6 +230,10 @@
         ` (${job.tiles} tiles × ${job.passes} passes)`],
       ['Size', `${job.width}×${job.height}, ${job.spp} spp`],
       ['Elapsed', duration(job.elapsed_seconds)],
+      ['Speed', job.samples_per_second ? `${count(Math.round(job.samples_per_second))} samples/s` : undefined],
+      ['Noise (est. relMSE)', typeof job.noise_estimate === 'number' ? job.noise_estimate.toPrecision(3) +
+        (job.target_error ? ` (target ${job.target_error})` : '') : undefined],
+      ['Stopped at target', job.stopped_at_target ? `yes, at ${job.spp_done} spp` : undefined],
       ['Remaining', LIVE.has(job.state) ? duration(job.eta_seconds) : undefined],
       ['Submitted', job.created > 1e9 ? new Date(job.created * 1000).toLocaleString() : undefined],
       ['Leases issued', job.leases_issued === undefined ? undefined : count(job.leases_issued)],

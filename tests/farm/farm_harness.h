@@ -227,6 +227,7 @@ inline Image local_render(const std::string& scene, const JobSettings& settings)
   rs.spp = loaded.loaded.scene->sampler.sample_count;
   rs.seed = settings.seed;
   rs.tile_size = 32;  // deliberately not the farm's tile size
+  rs.target_error = settings.target_error;
   return render(*loaded.loaded.scene, rs).to_image();
 }
 

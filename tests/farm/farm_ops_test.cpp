@@ -65,6 +65,8 @@ TEST(FarmOps, JobStopsAtItsTargetNoiseAtAPassBoundary) {
   reached.target_error = 0;
   const Image image = farm.image(id);
   EXPECT_EQ(differing_pixels(image, local_render(cornell(), reached)), 0);
+  // And `tessera render --target-error` with the same budget stops at the same pass.
+  EXPECT_EQ(differing_pixels(image, local_render(cornell(), s)), 0);
   // And the estimate is an estimate of the truth (printed, judged by people: issue 7 measures it).
   JobSettings converged = s;
   converged.spp = 1024;

@@ -1,5 +1,5 @@
 // Unidirectional path tracer (see integrator.h): next-event estimation and BSDF sampling at each
-// vertex, combined with the power heuristic; emitters hit by BSDF-sampled rays are weighted against
+// vertex, combined with the power heuristic (or one of them alone: IntegratorSettings::strategy); emitters hit by BSDF-sampled rays are weighted against
 // the light-sampling density at the previous vertex (pdf_li or pdf_env times the selection pmf).
 //
 // As `volpath` it also tracks participating media: each segment samples the current medium's
@@ -98,8 +98,8 @@ class PathIntegrator final : public Integrator {
           for (const Light* env : scene.infinite_lights()) {
             Rgb le = env->le_env(ray.d);
             if (le.is_black()) continue;
-            float w = prev_delta ? 1.f : power_heuristic(prev_pdf, env->pdf_env(ray.d) * scene.light_pmf(prev_ctx, env));
-            L += throughput * le * w;
+            float w = prev_delta ? 1.f : hit_weight(prev_pdf, [&] { return env->pdf_env(ray.d) * scene.light_pmf(prev_ctx, env); });
+            if (w > 0.f || s_.strategy == SamplingStrategy::Mis) L += throughput * le * w;
           }
         }
         break;
@@ -120,8 +120,8 @@ class PathIntegrator final : public Integrator {
         Rgb le = area->le(si, wo_world);
         if (!le.is_black()) {
           float w = prev_delta ? 1.f
-                               : power_heuristic(prev_pdf, area->pdf_li(prev_ctx.p, si) * scene.light_pmf(prev_ctx, area));
-          L += throughput * le * w;
+                               : hit_weight(prev_pdf, [&] { return area->pdf_li(prev_ctx.p, si) * scene.light_pmf(prev_ctx, area); });
+          if (w > 0.f || s_.strategy == SamplingStrategy::Mis) L += throughput * le * w;
         }
       }
 
@@ -179,15 +179,32 @@ class PathIntegrator final : public Integrator {
     return !throughput.is_black();
   }
 
-  // One light sample, MIS-weighted against the BSDF or phase function; not yet multiplied by the
-  // throughput.
+  // Weight of an emitter found by a BSDF/phase-sampled ray after a non-delta lobe (integrator.h);
+  // `light_pdf` gives next-event estimation's density for it, computed only when needed.
+  template <typename LightPdf>
+  float hit_weight(float prev_pdf, LightPdf&& light_pdf) const {
+    switch (s_.strategy) {
+      case SamplingStrategy::Bsdf: return 1.f;
+      case SamplingStrategy::Nee: return light_pdf() > 0.f ? 0.f : 1.f;
+      case SamplingStrategy::Mis: break;
+    }
+    return power_heuristic(prev_pdf, light_pdf());
+  }
+
+  // One light sample, weighted by the strategy (MIS: against the BSDF or phase function); not yet
+  // multiplied by the throughput.
   Rgb sample_direct(const Scene& scene, const Vertex& v, float u_pick, Vec2 u_light, RenderCounters& counters) const {
     float pmf = 0.f;
     const LightSampleContext ctx{v.p, v.si ? v.si->shading.n : Vec3(0.f)};
     const Light* light = scene.sample_light(ctx, u_pick, pmf);
+    const bool mis = s_.strategy == SamplingStrategy::Mis;
+    // BSDF-only keeps next-event estimation for the delta lights no sampled ray can hit.
+    const bool bsdf_only = s_.strategy == SamplingStrategy::Bsdf;
+    if (bsdf_only && light && !light->is_delta()) return {};
     LightSample ls;
     if (!light || !(pmf > 0.f) || !light->sample_li(v.p, u_light, ls)) return {};
     if (!(ls.pdf > 0.f) || ls.li.is_black()) return {};
+    if (bsdf_only && !ls.delta) return {};
     Rgb f;
     float scatter_pdf = 0.f;
     const Medium* shadow_medium = v.medium;
@@ -195,11 +212,11 @@ class PathIntegrator final : public Integrator {
       const Vec3 wi = v.si->to_local(ls.wi);
       if (!consistent_side(*v.si, ls.wi, wi)) return {};
       f = v.bsdf->eval(*v.si, v.wo, wi);
-      if (!ls.delta) scatter_pdf = v.bsdf->pdf(*v.si, v.wo, wi);
+      if (!ls.delta && mis) scatter_pdf = v.bsdf->pdf(*v.si, v.wo, wi);
       if (volumetric_) shadow_medium = medium_after(*v.si, ls.wi, v.medium);
     } else {
       f = Rgb(v.phase->eval(v.wo, ls.wi));
-      if (!ls.delta) scatter_pdf = v.phase->pdf(v.wo, ls.wi);
+      if (!ls.delta && mis) scatter_pdf = v.phase->pdf(v.wo, ls.wi);
     }
     if (f.is_black()) return {};
     Ray shadow = ls.dist < kInfinity ? spawn_ray_to(v.p, v.ng, ls.p_light) : spawn_ray(v.p, v.ng, ls.wi);
@@ -208,7 +225,7 @@ class PathIntegrator final : public Integrator {
     const Rgb tr = volumetric_ ? scene.transmittance(shadow, shadow_medium) : Rgb(scene.transmittance(shadow));
     if (tr.is_black()) return {};
     float light_pdf = ls.pdf * pmf;
-    float w = ls.delta ? 1.f : power_heuristic(light_pdf, scatter_pdf);
+    float w = ls.delta || !mis ? 1.f : power_heuristic(light_pdf, scatter_pdf);
     return f * ls.li * tr * (w / light_pdf);
   }
 
@@ -217,6 +234,24 @@ class PathIntegrator final : public Integrator {
 };
 
 }  // namespace
+
+const char* sampling_strategy_name(SamplingStrategy strategy) {
+  switch (strategy) {
+    case SamplingStrategy::Bsdf: return "bsdf";
+    case SamplingStrategy::Nee: return "nee";
+    case SamplingStrategy::Mis: break;
+  }
+  return "mis";
+}
+
+bool parse_sampling_strategy(const std::string& name, SamplingStrategy& out) {
+  for (SamplingStrategy s : {SamplingStrategy::Mis, SamplingStrategy::Bsdf, SamplingStrategy::Nee})
+    if (name == sampling_strategy_name(s)) {
+      out = s;
+      return true;
+    }
+  return false;
+}
 
 std::unique_ptr<Integrator> make_path_integrator(const IntegratorSettings& settings) {
   return std::make_unique<PathIntegrator>(settings, settings.type == IntegratorType::VolPath);

@@ -2,6 +2,7 @@
 
 #include "tessera/core/check.h"
 #include "tessera/render/integrator.h"
+#include "tessera/render/noise_estimate.h"
 #include "tessera/render/sampler.h"
 
 #include <tbb/blocked_range.h>
@@ -90,6 +91,7 @@ Film render(const Scene& scene, const RenderSettings& settings, const ProgressCa
   prog.spp = uint32_t(settings.spp);
   std::mutex mutex;  // guards counters and progress; taken once per tile
   RenderCounters counters;
+  double noise = 0;
 
   tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
   arena.execute([&] {
@@ -112,12 +114,18 @@ Film render(const Scene& scene, const RenderSettings& settings, const ProgressCa
       });
       begin = end;
       prog.samples_done = end;
+      if (settings.target_error > 0 && p + 1 < passes.size()) {
+        noise = estimate_noise(film).rel_mse;
+        if (noise <= settings.target_error) break;
+      }
     }
   });
   film.add_counters(counters);
   if (stats) {
     stats->counters = counters;
     stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    stats->spp_done = prog.samples_done;
+    stats->noise_estimate = settings.target_error > 0 ? (prog.samples_done == uint32_t(settings.spp) ? estimate_noise(film).rel_mse : noise) : 0;
   }
   return film;
 }

@@ -21,6 +21,7 @@ struct RenderOptions {
   std::map<std::string, std::string> defines;
   std::string integrator;                  // empty: as the scene says
   std::string light_selection;             // "power" or "bvh"; empty: the default (bvh)
+  double target_error = 0;                 // > 0: stop at this estimated relMSE (spp is the budget)
   bool allow_unsupported = false;
   bool quiet = false;
 };

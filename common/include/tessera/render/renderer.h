@@ -22,11 +22,17 @@ struct RenderSettings {
   uint32_t seed = 0;
   int threads = 0;        // 0: every hardware thread
   int tile_size = 32;     // pixels per tile side
+  /// > 0: stop after the first pass at which the estimated relMSE (noise_estimate.h) of the film
+  /// is at most this; spp is then the budget. Decided on whole passes only, so the image equals
+  /// a render with the spp reached (and a farm job with the same target).
+  double target_error = 0;
 };
 
 struct RenderStats {
   RenderCounters counters;  // samples, camera/bounce/shadow rays, NaN/Inf samples dropped
   double seconds = 0;
+  uint32_t spp_done = 0;      // samples per pixel rendered (less than spp when a target stopped it)
+  double noise_estimate = 0;  // estimated relMSE of the result (only computed with a target)
 };
 
 struct RenderProgress {

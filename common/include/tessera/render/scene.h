@@ -22,6 +22,8 @@ namespace tessera {
 // VolPath is the path tracer that also tracks participating media; the loader turns it into Path
 // on a scene without media (the same image, minus the sampler dimensions media would consume).
 enum class IntegratorType { Path, VolPath, Direct };
+// How path/volpath estimate direct light (integrator.h states each rule); Direct ignores it.
+enum class SamplingStrategy { Mis, Bsdf, Nee };
 
 struct IntegratorSettings {
   IntegratorType type = IntegratorType::Path;
@@ -34,6 +36,7 @@ struct IntegratorSettings {
   int bsdf_samples = 1;
   // How next-event estimation picks a light (light/light_sampler.h); read by Scene::finalize.
   LightSelection light_selection = LightSelection::Bvh;
+  SamplingStrategy strategy = SamplingStrategy::Mis;  // path/volpath only; not read from scene files
 };
 
 enum class SamplerType { Sobol, Independent };

@@ -1,0 +1,154 @@
+// `tessera bench convergence`: load once, then per strategy render at each budget and measure the
+// error against the reference (convergence.h).
+#include "tessera/cli/convergence.h"
+#include "tessera/image/image.h"
+#include "tessera/render/integrator.h"
+#include "tessera/render/noise_estimate.h"
+#include "tessera/render/renderer.h"
+#include "tessera/scene/load_context.h"
+#include "tessera/scene/scene_desc.h"
+
+#include <tbb/info.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+namespace tessera::cli {
+namespace {
+
+constexpr int kMaxSpp = 65536;
+
+bool write_text(const std::string& path, const std::string& text) {
+  auto parent = std::filesystem::path(path).parent_path();
+  if (!parent.empty()) std::filesystem::create_directories(parent);
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  return bool(out);
+}
+
+void print_time_to_target(const std::string& strategy, const std::vector<ConvergencePoint>& points, double target) {
+  TimeToTarget t = time_to_target(points, target);
+  if (!t.reached)
+    std::printf("time_to_target strategy=%s relmse=%g not reached\n", strategy.c_str(), target);
+  else if (t.at_first_budget)
+    std::printf("time_to_target strategy=%s relmse=%g seconds<=%.4g (reached at the first budget)\n",
+                strategy.c_str(), target, t.seconds);
+  else
+    std::printf("time_to_target strategy=%s relmse=%g seconds=%.4g\n", strategy.c_str(), target, t.seconds);
+}
+
+}  // namespace
+
+int run_bench_convergence(const ConvergenceOptions& options) {
+  std::vector<SamplingStrategy> strategies;
+  std::vector<std::string> names = options.strategies.empty() ? std::vector<std::string>{"mis"} : options.strategies;
+  for (const auto& name : names) {
+    SamplingStrategy s;
+    if (!parse_sampling_strategy(name, s)) {
+      std::fprintf(stderr, "tessera bench convergence: unknown strategy '%s' (use mis, bsdf, nee)\n", name.c_str());
+      return 2;
+    }
+    strategies.push_back(s);
+  }
+  std::vector<int> budgets = options.spp;
+  if (budgets.empty() && options.seconds <= 0) budgets = {1, 2, 4, 8, 16, 32, 64};
+  for (int spp : budgets)
+    if (spp <= 0 || spp > kMaxSpp) {
+      std::fprintf(stderr, "tessera bench convergence: --spp values must be in 1..%d\n", kMaxSpp);
+      return 2;
+    }
+  try {
+    Image ref = read_image(options.reference).to_rgb();
+    LoadOptions load;
+    load.allow_unsupported = options.allow_unsupported;
+    load.width = options.width;
+    load.height = options.height;
+    LoadResult loaded = load_scene(parse_scene_file(options.scene), load);
+    for (const auto& m : loaded.messages)
+      if (m.level == LoadMessage::Level::Warning) std::cerr << "warning: " << m.loc.str() << ": " << m.text << "\n";
+    Scene& scene = *loaded.scene;
+    const int w = scene.film.crop_w(), h = scene.film.crop_h();
+    if (w != ref.width() || h != ref.height()) {
+      std::fprintf(stderr, "error: the reference %s is %dx%d but the render is %dx%d (%s)\n",
+                   options.reference.c_str(), ref.width(), ref.height(), w, h,
+                   options.width > 0 || options.height > 0 ? "--width/--height" : "the scene's film; use --width/--height");
+      return 1;
+    }
+    if (scene.integrator.type == IntegratorType::Direct)
+      std::fprintf(stderr, "note: the scene uses the direct integrator, which has no strategies: all equal\n");
+
+    RenderSettings settings;
+    settings.threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
+    // Warm up threads and caches so the first timed render is not charged for them.
+    settings.spp = 1;
+    settings.seed = options.seed;
+    (void)render(scene, settings);
+
+    std::printf("convergence scene=%s %dx%d threads=%d\n", options.scene.c_str(), w, h, settings.threads);
+    std::vector<ConvergencePoint> all;
+    for (size_t si = 0; si < strategies.size(); ++si) {
+      scene.integrator.strategy = strategies[si];
+      std::vector<ConvergencePoint> mine;
+      auto run_budget = [&](size_t index, int spp) {
+        settings.spp = spp;
+        settings.seed = options.seed + uint32_t(index);
+        RenderStats stats;
+        Film film = render(scene, settings, {}, &stats);
+        ConvergencePoint p;
+        p.strategy = names[si];
+        p.spp = spp;
+        p.seconds = stats.seconds;
+        p.error = measure_error(film.to_image().to_rgb(), ref);
+        p.noise_estimate = estimate_noise(film).rel_mse;
+        std::printf("strategy=%s spp=%d seconds=%.4f relmse=%.5g relmse_trim=%.5g mse=%.5g mean_ratio=%.5f "
+                    "noise_estimate=%.5g\n",
+                    p.strategy.c_str(), p.spp, p.seconds, p.error.rel_mse, p.error.rel_mse_trim, p.error.mse,
+                    p.error.mean_ratio, p.noise_estimate);
+        std::fflush(stdout);
+        mine.push_back(p);
+      };
+      for (size_t i = 0; i < budgets.size(); ++i) run_budget(i, budgets[i]);
+      if (options.seconds > 0) {
+        int spp = budgets.empty() ? 1 : budgets.back() * 2;
+        while (spp <= kMaxSpp && (mine.empty() || mine.back().seconds < options.seconds)) {
+          run_budget(mine.size(), spp);
+          spp *= 2;
+        }
+      }
+      for (double target : {1e-2, 1e-3}) print_time_to_target(names[si], mine, target);
+      all.insert(all.end(), mine.begin(), mine.end());
+    }
+
+    if (!options.csv.empty()) {
+      std::ostringstream csv;
+      write_convergence_csv(csv, all);
+      if (!write_text(options.csv, csv.str())) {
+        std::fprintf(stderr, "error: cannot write %s\n", options.csv.c_str());
+        return 1;
+      }
+      std::fprintf(stderr, "wrote %s\n", options.csv.c_str());
+    }
+    if (!options.plot.empty()) {
+      std::string title = std::filesystem::path(options.scene).parent_path().filename().string();
+      if (title.empty()) title = options.scene;
+      // (snprintf rather than string concatenation: GCC 12 warns falsely on the latter, -Wrestrict)
+      char suffix[96];
+      std::snprintf(suffix, sizeof suffix, " %dx%d, %d threads: relMSE against the reference", w, h, settings.threads);
+      title += suffix;
+      if (!write_text(options.plot, convergence_svg(all, title))) {
+        std::fprintf(stderr, "error: cannot write %s\n", options.plot.c_str());
+        return 1;
+      }
+      std::fprintf(stderr, "wrote %s\n", options.plot.c_str());
+    }
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
+  }
+}
+
+}  // namespace tessera::cli

@@ -1,0 +1,101 @@
+// Scale and placement: the Cornell box scaled by 1e-4 and 1e4, and translated 1e4 away from the
+// origin together with its camera, renders like the original.
+//
+// Expectation: radiance does not depend on the unit of length, so each variant is the same image.
+// With the same seed every variant draws the same random numbers, so their paths differ only by
+// float rounding of the geometry (and, where that flips a decision, by a whole path): the relMSE
+// against the original is far below the noise of either image (each is ~0.05 from the converged
+// image at 32 spp). Acne shows as a darker image (self-shadowing), leaks as light in contact shadows
+// (brighter), holes as black pixels: mean luminance must agree and no pixel may turn black.
+//
+// Measured (64x64, 32 spp, seed 7, Release): scale 1e4: relMSE 1.0e-6, mean ratio 0.99999, no black
+// pixel. Scale 1e-4: relMSE 6.5e-3, mean ratio 1.0144, 2 black pixels. Translate 1e4: relMSE 1.4e-2,
+// mean ratio 1.0024, 12 black pixels. The last two fail: see the comment on each.
+#include "hardcases/hardcase_support.h"
+#include "test_support.h"
+
+#include <cstdio>
+
+namespace tessera {
+namespace {
+
+constexpr int kSize = 64, kSpp = 32;
+
+std::string cornell_path() { return test::shared_path("scenes/cornell-box/scene.xml"); }
+
+Image render_variant(const Transform& world, const std::string& name) {
+  LoadResult r = test::load_cornell(cornell_path(), world, kSize, kSpp);
+  EXPECT_TRUE(r.unsupported.empty()) << name;
+  return test::render_checked(*r.scene, test::hard_settings(kSpp), name).to_image();
+}
+
+const Image& original() {
+  static const Image img = render_variant(Transform(), "original");
+  return img;
+}
+
+/// `max_rel_mse`: the bound on the relMSE against the untransformed render (same seed).
+void expect_like_original(const Transform& world, const std::string& name, double max_rel_mse) {
+  const Image& ref = original();
+  const double mean0 = test::mean_luminance(ref), black0 = test::black_fraction(ref);
+  ASSERT_GT(mean0, 0.05);
+  ASSERT_EQ(black0, 0.0) << "the original shows no black pixel at this resolution";
+  const Image img = render_variant(world, name);
+  const double err = rel_mse(img, ref), ratio = test::mean_luminance(img) / mean0;
+  const double black = test::black_fraction(img);
+  std::printf("%-14s relMSE vs original %.3g, mean ratio %.6f, black pixels %.0f\n", name.c_str(), err, ratio,
+              black * kSize * kSize);
+  EXPECT_LT(err, max_rel_mse) << name;
+  EXPECT_NEAR(ratio, 1.0, 2e-3) << name << ": acne (darker) or leaks (brighter)";
+  EXPECT_EQ(black, 0.0) << name << ": holes";
+}
+
+// 1e4 is not a power of two, so every vertex rounds differently, but relatively: the same paths
+// up to ~1 ulp. Measured 1.0e-6; bound 1e-4 (100x margin, still 500x below the noise level).
+TEST(HardScale, CornellBoxScaledBy1e4) {
+  TESSERA_REQUIRE_FILE(cornell_path());
+  expect_like_original(Transform::scale(Vec3(1e4f)), "scale 1e4", 1e-4);
+}
+
+// DISABLED: fails (relMSE 6.5e-3, 1.4% brighter, 2 black pixels). offset_ray_origin()
+// (render/interaction.cpp) offsets points with |coordinate| < 1/32 by the fixed 1/65536 (Wächter and
+// Binder's float_scale): 1.5e-5 is 7% of this box's 2e-4 size, so spawned rays start far off the
+// surface: shadow rays from the floor start above the boxes' contact edges (leaks) and rays from
+// points near the open front start outside the box (black). Expected once offsets scale with the
+// hit's own error bound: like the 1e4 case (bound 1e-4).
+TEST(HardScale, DISABLED_CornellBoxScaledBy1eMinus4) {
+  TESSERA_REQUIRE_FILE(cornell_path());
+  expect_like_original(Transform::scale(Vec3(1e-4f)), "scale 1e-4", 1e-4);
+}
+
+// DISABLED: fails (relMSE 1.4e-2, 12 black pixels on the short box's front face near the open side).
+// Far from the origin offset_ray_origin() moves each coordinate by 256 ulps: at 1e4 that is 0.25
+// world units, 1/8 of the box, so a bounce ray from the short box's front face (z ~ 0.72) starts
+// beyond the open front (z = 1) and sees only the void. Vertices themselves lose only ~5e-4 (ulp at
+// 1e4 is 1e-3). Expected with error-bound offsets: relMSE < 1e-2 (as the 1e2 case), mean within
+// 0.2%, no black pixel.
+TEST(HardScale, DISABLED_CornellBoxTranslated1e4WithItsCamera) {
+  TESSERA_REQUIRE_FILE(cornell_path());
+  expect_like_original(Transform::translate(Vec3(1e4f, 1e4f, 1e4f)), "translate 1e4", 1e-2);
+}
+
+// The same failure at 1e3 (relMSE 4.3e-3, 1.3% darker, 1 black pixel): 256 ulps are 0.016..0.03
+// there, more than the 0.02 the light hangs below the ceiling, so rays from the ceiling around the
+// light start below it and see its black back. Expected with error-bound offsets: as at 1e4.
+TEST(HardScale, DISABLED_CornellBoxTranslated1e3WithItsCamera) {
+  TESSERA_REQUIRE_FILE(cornell_path());
+  expect_like_original(Transform::translate(Vec3(1e3f, 1e3f, 1e3f)), "translate 1e3", 1e-2);
+}
+
+// At 1e2 (ulp 7.6e-6 .. 1.5e-5, 256 ulps <= 4e-3 world units, 1/5 of the light's gap to the
+// ceiling) the offsets are still small against every feature of the box. Translation rounds every
+// vertex and hit point in absolute terms, so long paths decorrelate more than under scaling:
+// measured relMSE 3.7e-3, mean ratio 0.99933. Bound 1e-2 (still ~10x below the relMSE of two
+// independent 32-spp renders), the mean within 0.2% and no black pixel carry the bias check.
+TEST(HardScale, CornellBoxTranslated1e2WithItsCamera) {
+  TESSERA_REQUIRE_FILE(cornell_path());
+  expect_like_original(Transform::translate(Vec3(1e2f, 1e2f, 1e2f)), "translate 1e2", 1e-2);
+}
+
+}  // namespace
+}  // namespace tessera
