@@ -3,6 +3,7 @@
 #include "tessera/cli/progress.h"
 #include "tessera/image/image.h"
 #include "tessera/render/renderer.h"
+#include "tessera/render/shape.h"
 #include "tessera/scene/load_context.h"
 #include "tessera/scene/scene_desc.h"
 
@@ -13,6 +14,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <set>
 
 namespace tessera::cli {
 namespace {
@@ -40,6 +42,20 @@ std::vector<std::string> output_paths(const RenderOptions& options, const Scene&
   std::vector<std::string> outs = {stem + ".exr"};
   if (scene.film.ldr) outs.push_back(stem + ".png");
   return outs;
+}
+
+// Bytes of the triangle meshes' vertex and index arrays (a mesh shared by shapes counted once).
+size_t mesh_bytes(const Scene& scene) {
+  std::set<const MeshData*> seen;
+  size_t bytes = 0;
+  for (const auto& shape : scene.shapes) {
+    if (shape->kind() != Shape::Kind::Mesh) continue;
+    const MeshData& m = static_cast<const TriangleMeshShape&>(*shape).mesh();
+    if (!seen.insert(&m).second) continue;
+    bytes += m.positions.size() * sizeof(Vec3) + m.normals.size() * sizeof(Vec3) + m.uvs.size() * sizeof(Vec2) +
+             m.indices.size() * sizeof(uint32_t);
+  }
+  return bytes;
 }
 
 void write_outputs(const RenderOptions& options, const Scene& scene, const Film& film, uint32_t spp) {
@@ -128,13 +144,17 @@ int run_render(const RenderOptions& options) {
 
     const auto& c = stats.counters;
     BvhStats bvh = scene.accel().stats();
+    const size_t meshes = mesh_bytes(scene);
     std::fprintf(stderr,
                  "scene %s: %zu triangles, %zu shapes, %zu lights (%zu selectable, %s selection); BVH %zu nodes, %.1f MB\n"
+                 "memory: BVH %.1f bytes/triangle, meshes %.1f MB (%.1f bytes/triangle)\n"
                  "times: parse %.3f s, load %.3f s (BVH build %.3f s), render %.3f s\n"
                  "render: %dx%d, %d spp, %d threads: %.3g samples/s, %.3g rays/s",
                  options.scene.c_str(), scene.num_triangles(), scene.shapes.size(), scene.lights.size(),
                  scene.light_sampler().lights().size(), light_selection_name(scene.light_sampler().strategy()),
-                 bvh.nodes, double(bvh.bytes) / 1e6, parse_s, load_s - scene.bvh_build_seconds(),
+                 bvh.nodes, double(bvh.bytes) / 1e6,
+                 double(bvh.bytes) / double(std::max<size_t>(scene.num_triangles(), 1)), double(meshes) / 1e6,
+                 double(meshes) / double(std::max<size_t>(scene.num_triangles(), 1)), parse_s, load_s - scene.bvh_build_seconds(),
                  scene.bvh_build_seconds(), stats.seconds, film.width(), film.height(), settings.spp,
                  settings.threads, double(c.samples) / std::max(stats.seconds, 1e-9),
                  double(c.rays()) / std::max(stats.seconds, 1e-9));

@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 namespace tessera {
 namespace {
 
@@ -46,17 +48,21 @@ void check_no_self_hit(Vec3 center, float size, uint64_t seed) {
     if (!bvh.intersect(Ray{o, target - o}, hit)) continue;
     ++hits;
     const Triangle& t = tris[hit.prim];
-    const Vec3 p = t[0] * (1.f - hit.b1 - hit.b2) + t[1] * hit.b1 + t[2] * hit.b2;
+    const float b0 = 1.f - hit.b1 - hit.b2;
+    const Vec3 p = t[0] * b0 + t[1] * hit.b1 + t[2] * hit.b2;
+    const Vec3 p_error = barycentric_point_error(t[0], t[1], t[2], b0, hit.b1, hit.b2);
     const Vec3 ng = geometric_normal(t);
     for (int k = 0; k < 4; ++k) {
       Vec3 d = test::random_unit(rng);
       if (k == 3) d = normalize(d - ng * dot(d, ng) + ng * (dot(d, ng) < 0 ? -1e-3f : 1e-3f));  // grazing
       Hit again;
+      if (bvh.intersect(spawn_ray(p, p_error, ng, d), again)) ++self_hits;
+      // The overload without a bound estimates it from |p|: as good on these small grids.
       if (bvh.intersect(spawn_ray(p, ng, d), again)) ++self_hits;
     }
   }
   EXPECT_GT(hits, 3000u);
-  EXPECT_EQ(self_hits, 0u) << "of " << 4 * hits << " spawned rays";
+  EXPECT_EQ(self_hits, 0u) << "of " << 8 * hits << " spawned rays";
 }
 
 TEST(Offset, NoSelfHitNearOrigin) { check_no_self_hit(Vec3(0.01f, -0.02f, 0.005f), 0.05f, 21); }
@@ -77,12 +83,14 @@ TEST(Offset, SphereSpawnedRaysLeaveTheSurface) {
       const Vec3 aim = s.center + test::random_in_box(rng, -0.5f * s.radius, 0.5f * s.radius);
       Hit hit;
       if (!bvh.intersect(Ray{o, normalize(aim - o)}, hit)) continue;
-      const Vec3 n = normalize(o + normalize(aim - o) * hit.t - s.center);
-      const Vec3 p = s.center + n * s.radius;
+      const SphereShape shape(s.center, s.radius, false);
+      Vec3 p_error;
+      const Vec3 p = shape.reproject(o + normalize(aim - o) * hit.t, p_error);
+      const Vec3 n = normalize(p - s.center);
       Vec3 d = test::random_unit(rng);
       ++tried;
       Hit again;
-      const bool h = bvh.intersect(spawn_ray(p, n, d), again);
+      const bool h = bvh.intersect(spawn_ray(p, p_error, n, d), again);
       if (dot(d, n) > 0.f ? h : (!h || again.t < 1e-3f * s.radius)) ++bad;
     }
     EXPECT_GT(tried, 1000u);
@@ -114,23 +122,35 @@ TEST(Offset, WithoutOffsetSelfHitsHappen) {
 }
 
 TEST(Offset, MovesAlongNormalOnBothSidesOfZero) {
+  // The offset is the error box projected on the normal, rounded away: every coordinate the normal
+  // has a component along moves to the side w points to, by at least one float, and no further
+  // than the projection plus that rounding; other coordinates stay.
   for (Vec3 p : {Vec3(0.f), Vec3(1e-3f, -1e-3f, 0.f), Vec3(10.f, -10.f, 1e4f), Vec3(-1e6f, 1e6f, 3.f)}) {
+    const Vec3 err = estimated_point_error(p) + Vec3(1e-30f);
     for (Vec3 nrm : {Vec3(1, 0, 0), Vec3(0, -1, 0), normalize(Vec3(1, 1, -1))}) {
-      const Vec3 q = offset_ray_origin(p, nrm);
-      for (int a = 0; a < 3; ++a) {
-        if (nrm[a] * 256.f >= 1.f || (std::abs(p[a]) < 1.f / 32.f && nrm[a] > 0.f)) {
-          EXPECT_GT(q[a], p[a]);
+      for (float side : {1.f, -1.f}) {
+        const Vec3 q = offset_ray_origin(p, err, nrm, nrm * side);
+        const float d = dot(vabs(nrm), err);
+        for (int a = 0; a < 3; ++a) {
+          if (nrm[a] * side > 0.f) {
+            EXPECT_GT(q[a], p[a]);
+          } else if (nrm[a] * side < 0.f) {
+            EXPECT_LT(q[a], p[a]);
+          } else {
+            EXPECT_EQ(q[a], p[a]);
+          }
+          const float ulp = std::nextafter(std::abs(p[a]) + d, kInfinity) - (std::abs(p[a]) + d);
+          EXPECT_LE(std::abs(q[a] - p[a]), d * std::abs(nrm[a]) + 2.f * ulp);
         }
-        if (nrm[a] * 256.f <= -1.f || (std::abs(p[a]) < 1.f / 32.f && nrm[a] < 0.f)) {
-          EXPECT_LT(q[a], p[a]);
-        }
-        if (nrm[a] == 0.f) {
-          EXPECT_EQ(q[a], p[a]);
-        }
+        EXPECT_GT(dot(q - p, nrm * side), 0.f);
       }
-      EXPECT_GT(dot(q - p, nrm), 0.f);
     }
   }
+  // The offset follows the error bound, not the position: a tiny error gives a tiny offset far out.
+  const Vec3 p(1e4f, 1e4f, 1e4f);
+  const Vec3 q = offset_ray_origin(p, Vec3(0.f), Vec3(0, 0, 1), Vec3(0, 0, 1));
+  EXPECT_EQ(q.x, p.x);
+  EXPECT_EQ(q.z, p.z);  // no error, no offset
 }
 
 TEST(Offset, SpawnRayToStopsShortOfTarget) {

@@ -32,17 +32,22 @@ float fresnel_dielectric(float cos_theta_i, float eta, float* cos_theta_t) {
 
 namespace {
 
-// Exact unpolarised reflectance of a conductor (Mitsuba's fresnelConductorExact).
-float conductor_channel(float cos_i, float eta, float k) {
-  float cos2 = cos_i * cos_i, sin2 = 1.f - cos2, sin4 = sin2 * sin2;
-  float temp1 = eta * eta - k * k - sin2;
-  float a2pb2 = std::sqrt(std::max(temp1 * temp1 + 4.f * k * k * eta * eta, 0.f));
-  float a = std::sqrt(std::max(0.5f * (a2pb2 + temp1), 0.f));
-  float term1 = a2pb2 + cos2, term2 = 2.f * a * cos_i;
-  float rs2 = (term1 - term2) / (term1 + term2);
-  float term3 = a2pb2 * cos2 + sin4, term4 = term2 * sin2;
-  float rp2 = rs2 * (term3 - term4) / (term3 + term4);
-  return std::clamp(0.5f * (rp2 + rs2), 0.f, 1.f);
+// Exact unpolarised reflectance of a conductor (Mitsuba's fresnelConductorExact), in double: in
+// float, (eta^2 - k^2)^2 overflows to NaN once eta or k passes ~4e9, and near grazing incidence
+// sin^2 = 1 - cos^2 rounds to 1, which made an index-matched interface (eta 1, k 0) a mirror
+// (F = 1 instead of 0 at cos 1e-4). Double keeps both exact enough for any float input below 1e38.
+float conductor_channel(float cos_i_f, float eta_f, float k_f) {
+  const double cos_i = cos_i_f, eta = eta_f, k = k_f;
+  const double cos2 = cos_i * cos_i, sin2 = 1.0 - cos2, sin4 = sin2 * sin2;
+  const double temp1 = eta * eta - k * k - sin2;
+  const double a2pb2 = std::sqrt(std::max(temp1 * temp1 + 4.0 * k * k * eta * eta, 0.0));
+  const double a = std::sqrt(std::max(0.5 * (a2pb2 + temp1), 0.0));
+  const double term1 = a2pb2 + cos2, term2 = 2.0 * a * cos_i;
+  const double rs2 = (term1 - term2) / (term1 + term2);
+  const double term3 = a2pb2 * cos2 + sin4, term4 = term2 * sin2;
+  const double rp2 = rs2 * (term3 - term4) / (term3 + term4);
+  const double f = 0.5 * (rp2 + rs2);
+  return std::isnan(f) ? 1.f : float(std::clamp(f, 0.0, 1.0));  // NaN only for infinite eta or k: a mirror
 }
 
 }  // namespace

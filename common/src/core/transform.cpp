@@ -154,6 +154,22 @@ Vec3 Transform::apply_point(Vec3 p) const {
   return Vec3(float(r[0] / r[3]), float(r[1] / r[3]), float(r[2] / r[3]));
 }
 
+Vec3 Transform::apply_point_error(Vec3 p, Vec3 p_error) const {
+  const auto& a = m_.m;
+  // apply_point sums in double and rounds once to float: a relative 2^-24 of the result plus a
+  // few double roundings of the terms; gamma(3) (float) of the terms' magnitude bounds both. The
+  // carried error is widened by the same factor for the rounding of its own evaluation.
+  constexpr float eps = 0.5f * 1.1920928955078125e-7f;
+  constexpr float g3 = (3.f * eps) / (1.f - 3.f * eps);
+  float out[3];
+  for (int i = 0; i < 3; ++i) {
+    const double terms = std::abs(a[i][0] * p.x) + std::abs(a[i][1] * p.y) + std::abs(a[i][2] * p.z) + std::abs(a[i][3]);
+    const double carried = std::abs(a[i][0]) * p_error.x + std::abs(a[i][1]) * p_error.y + std::abs(a[i][2]) * p_error.z;
+    out[i] = float(g3 * terms + (1.0 + g3) * carried);
+  }
+  return Vec3(out[0], out[1], out[2]);
+}
+
 Vec3 Transform::apply_vector(Vec3 v) const {
   const auto& a = m_.m;
   return Vec3(float(a[0][0] * v.x + a[0][1] * v.y + a[0][2] * v.z),

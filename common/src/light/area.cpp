@@ -47,6 +47,11 @@ class AreaLight final : public Light {
       float pdf = 0.f;
       shape.sample_area({0.3f, 0.6f}, p, n, pdf);
       sphere_flipped_ = dot(n, p - sphere_->center()) < 0.f;
+    } else {
+      // Shape::sample_area gives no error bound; any barycentric point of the mesh is within
+      // error_gamma(10) max |vertex| per axis (barycentric_point_error with b summing to 1).
+      const Bounds3 b = shape.bounds();
+      if (!b.empty()) mesh_error_ = vmax(vabs(b.lo), vabs(b.hi)) * error_gamma(10);
     }
   }
 
@@ -62,7 +67,11 @@ class AreaLight final : public Light {
       if (!(pdf_area > 0.f)) return false;
       pdf = pdf_area;  // converted below, once the distance is known
     }
-    return detail::emission_sample(ref_p, p, n, pdf, /*pdf_is_area=*/!cone, radiance_, out);
+    Vec3 p_error = mesh_error_;
+    if (sphere_) p = sphere_->reproject(p, p_error);
+    if (!detail::emission_sample(ref_p, p, n, pdf, /*pdf_is_area=*/!cone, radiance_, out)) return false;
+    out.p_light_error = p_error;
+    return true;
   }
 
   Rgb le(const SurfaceInteraction& si, Vec3 w) const override {
@@ -142,6 +151,7 @@ class AreaLight final : public Light {
   const Shape& shape_;
   const SphereShape* sphere_ = nullptr;
   bool sphere_flipped_ = false;
+  Vec3 mesh_error_;  // error bound of any point sample_area returns on a mesh
   Rgb radiance_;
 };
 

@@ -19,6 +19,7 @@ inline bool point_emitter_sample(Vec3 position, Vec3 ref_p, LightSample& out) {
   out.wi = d / dist;
   out.li = Rgb(1.f / dist2);
   out.p_light = position;
+  out.p_light_error = Vec3(0.f);
   out.n_light = Vec3(0.f);
   out.dist = dist;
   out.pdf = 1.f;
@@ -43,6 +44,7 @@ inline bool emission_sample(Vec3 ref_p, Vec3 p, Vec3 n, float pdf, bool pdf_is_a
   out.wi = wi;
   out.li = radiance;
   out.p_light = p;
+  out.p_light_error = Vec3(0.f);  // the caller knows the bound of its point
   out.n_light = n;
   out.dist = dist;
   out.pdf = pdf;

@@ -37,8 +37,11 @@ class TriangleLight final : public Light {
   bool sample_li(Vec3 ref_p, Vec2 u, LightSample& out) const override {
     if (!(area_ > 0.f)) return false;
     const Vec2 b = square_to_uniform_triangle(u);
-    const Vec3 p = p0_ * (1.f - b.x - b.y) + p1_ * b.x + p2_ * b.y;
-    return detail::emission_sample(ref_p, p, n_, 1.f / area_, /*pdf_is_area=*/true, radiance_, out);
+    const float b0 = 1.f - b.x - b.y;
+    const Vec3 p = p0_ * b0 + p1_ * b.x + p2_ * b.y;
+    if (!detail::emission_sample(ref_p, p, n_, 1.f / area_, /*pdf_is_area=*/true, radiance_, out)) return false;
+    out.p_light_error = barycentric_point_error(p0_, p1_, p2_, b0, b.x, b.y);
+    return true;
   }
 
   Rgb le(const SurfaceInteraction& si, Vec3 w) const override {

@@ -45,7 +45,7 @@ class DirectIntegrator final : public Integrator {
       if (!consistent_side(si, ls.wi, wi)) continue;
       Rgb f = bsdf->eval(si, wo, wi);
       if (f.is_black()) continue;
-      Ray shadow = ls.dist < kInfinity ? spawn_ray_to(si.p, si.ng, ls.p_light) : spawn_ray(si.p, si.ng, ls.wi);
+      Ray shadow = ls.dist < kInfinity ? spawn_ray_to(si, ls.p_light, ls.p_light_error, ls.n_light) : spawn_ray(si, ls.wi);
       shadow.time = ray.time;
       ++counters.shadow_rays;
       const float tr = scene.transmittance(shadow);
@@ -62,7 +62,7 @@ class DirectIntegrator final : public Integrator {
       if (!bsdf->sample(si, wo, u_lobe, u_bsdf, bs)) continue;
       const Vec3 wi_world = si.to_world(bs.wi);
       if (!consistent_side(si, wi_world, bs.wi)) continue;
-      Ray next = spawn_ray(si.p, si.ng, wi_world);
+      Ray next = spawn_ray(si, wi_world);
       next.time = ray.time;
       ++counters.bounce_rays;
       SurfaceInteraction hit;

@@ -110,7 +110,7 @@ class PathIntegrator final : public Integrator {
         // An index-matched boundary: only the medium changes; the path vertex stays where it was.
         if (++null_crossings > kMaxNullCrossings) break;
         medium = medium_after(si, ray.d, medium);
-        ray = spawn_ray(si.p, si.ng, ray.d);
+        ray = spawn_ray(si, ray.d);
         continue;
       }
       null_crossings = 0;
@@ -161,7 +161,7 @@ class PathIntegrator final : public Integrator {
       ++depth;
       if (media) medium = medium_after(si, wi_world, medium);
       if (!survives_roulette(depth, throughput, eta, u_rr)) break;
-      ray = spawn_ray(si.p, si.ng, wi_world);
+      ray = spawn_ray(si, wi_world);
       ++counters.bounce_rays;
     }
     return L;
@@ -219,7 +219,9 @@ class PathIntegrator final : public Integrator {
       if (!ls.delta && mis) scatter_pdf = v.phase->pdf(v.wo, ls.wi);
     }
     if (f.is_black()) return {};
-    Ray shadow = ls.dist < kInfinity ? spawn_ray_to(v.p, v.ng, ls.p_light) : spawn_ray(v.p, v.ng, ls.wi);
+    const Vec3 p_error = v.si ? v.si->p_error : Vec3(0.f);  // a medium vertex is exact
+    Ray shadow = ls.dist < kInfinity ? spawn_ray_to(v.p, p_error, v.ng, ls.p_light, ls.p_light_error, ls.n_light)
+                                     : spawn_ray(v.p, p_error, v.ng, ls.wi);
     shadow.time = v.time;
     ++counters.shadow_rays;
     const Rgb tr = volumetric_ ? scene.transmittance(shadow, shadow_medium) : Rgb(scene.transmittance(shadow));

@@ -102,7 +102,7 @@ float alpha_test_u(const Ray& r) {
 // origin offset past the surface, the remaining range kept.
 Ray continue_ray(const Ray& r, const SurfaceInteraction& si, float t) {
   Ray next = r;
-  next.o = offset_ray_origin(si.p, dot(r.d, si.ng) < 0.f ? -si.ng : si.ng);
+  next.o = offset_ray_origin(si.p, si.p_error, si.ng, r.d);
   next.tmax = r.tmax - t;
   return next;
 }

@@ -83,6 +83,7 @@ void Scene::fill_moving(const Ray& ray, const Hit& hit, SurfaceInteraction& si) 
   // keeps its handedness relative to the normal.
   const Frame sh = si.shading;
   const bool right_handed = dot(cross(sh.n, sh.s), sh.t) >= 0.f;
+  si.p_error = xf.apply_point_error(si.p, si.p_error);
   si.p = xf.apply_point(si.p);
   si.ng = normalize(xf.apply_normal(si.ng));
   Frame f;

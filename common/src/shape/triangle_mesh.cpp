@@ -86,6 +86,7 @@ void TriangleMeshShape::fill_interaction(const Ray& ray, const Hit& hit, uint32_
   // Re-interpolating from the vertices keeps p on the triangle's plane (ray.at(t) drifts off it
   // by the error in t), which the self-intersection offset relies on.
   si.p = tri.p0 * b0 + tri.p1 * b1 + tri.p2 * b2;
+  si.p_error = barycentric_point_error(tri.p0, tri.p1, tri.p2, b0, b1, b2);
   si.t = hit.t;
   si.ng = geometric_normal(tri, flip_);
 

@@ -233,7 +233,18 @@ std::shared_ptr<Texture> make_bitmap(const SceneNode& node, LoadContext& ctx) {
       Image stored = read_image(path);
       if (stored.empty()) throw SceneError("image has no pixels");
       Image decoded = decode_bitmap_values(stored, gamma, raw);
-      if (channel_index >= 0) return extract_channel(decoded, channel_index);
+      if (channel_index >= 0) decoded = extract_channel(decoded, channel_index);
+      // A NaN or infinite texel would turn every path that touches it into a dropped sample;
+      // read it as 0, as envmaps do (envmap.cpp), and say so once per image.
+      size_t bad = 0;
+      for (float* v = decoded.data(), *end = v + decoded.values().size(); v != end; ++v) {
+        if (std::isfinite(*v)) continue;
+        *v = 0.f;
+        ++bad;
+      }
+      if (bad)
+        ctx.warn(file->loc, node.describe() + ": " + std::to_string(bad) + " non-finite texel value(s) in '" + name +
+                                "' read as 0");
       return decoded;
     } catch (const SceneError& e) {
       // The reader names the file; the scene location says which texture wanted it.

@@ -49,6 +49,10 @@ class Transform {
   bool swaps_handedness() const;
 
   Vec3 apply_point(Vec3 p) const;
+  /// Error bound per axis of apply_point(p) for a `p` itself within `p_error` of the exact point
+  /// (pbrt-v4's Transform of a Point3fi): the input error carried through the matrix plus the
+  /// rounding of the result. Affine transforms (the last row 0 0 0 1).
+  Vec3 apply_point_error(Vec3 p, Vec3 p_error) const;
   Vec3 apply_vector(Vec3 v) const;
   /// Normals transform by the inverse transpose, so non-uniform scales keep them perpendicular.
   Vec3 apply_normal(Vec3 n) const;

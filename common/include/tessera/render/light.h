@@ -27,6 +27,8 @@ struct LightSample {
   Vec3 wi;              // unit, world space, from the reference point towards the light
   Vec3 p_light;         // point on the light (for infinite lights: far along wi)
   Vec3 n_light;         // surface normal at p_light (zero for point/infinite lights)
+  Vec3 p_light_error;   // rounding-error bound of p_light per axis (SurfaceInteraction::p_error);
+                        // zero for points not on a surface
   float dist = kInfinity;  // distance to p_light; kInfinity for infinite lights
   float pdf = 0.f;
   bool delta = false;
