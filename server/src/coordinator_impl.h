@@ -66,6 +66,15 @@ struct Coordinator::Impl {
   WorkerInfo* find_worker(uint64_t id);
   /// Under `mu`: ends a lease (the unit becomes available again unless done).
   void end_lease(std::map<uint64_t, LeaseInfo>::iterator it);
+  /// Under `mu`: ends every lease for which `pred(const LeaseInfo&)` holds.
+  template <class Pred>
+  void end_leases_if(Pred pred) {
+    for (auto l = leases.begin(); l != leases.end();) {
+      auto next = std::next(l);
+      if (pred(l->second)) end_lease(l);
+      l = next;
+    }
+  }
   /// Under `mu`: persists a job's phase; a job that ended writes its image, drops its film and
   /// (with `notify`) has its webhook called.
   void save_phase(JobState& job, bool notify = true);

@@ -426,11 +426,7 @@ Status Coordinator::cancel_job(uint64_t id) {
     return make_error(Code::Conflict, "job_finished", "job " + std::to_string(id) + " is already " + phase_name(job.phase));
   job.phase = JobPhase::Cancelled;
   job.finished = wall_seconds();
-  for (auto l = s.leases.begin(); l != s.leases.end();) {
-    auto next = std::next(l);
-    if (l->second.job == id) s.end_lease(l);
-    l = next;
-  }
+  s.end_leases_if([&](const LeaseInfo& l) { return l.job == id; });
   try {
     s.save_phase(job);
   } catch (const std::exception& e) {

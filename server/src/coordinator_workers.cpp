@@ -230,11 +230,7 @@ Result<json> Coordinator::upload_result(uint64_t worker, uint64_t lease, std::st
   if (!(result.film.rect() == job.rect(unit)) || result.sample_begin != job.sample_begin(unit) ||
       result.sample_end != job.sample_end(unit))
     return make_error(Code::BadRequest, "bad_result", "the result's rectangle or samples do not match the unit");
-  for (auto l = s.leases.begin(); l != s.leases.end();) {
-    auto next = std::next(l);
-    if (l->second.job == job.id() && l->second.unit == unit && l->second.worker == worker) s.end_lease(l);
-    l = next;
-  }
+  s.end_leases_if([&](const LeaseInfo& l) { return l.job == job.id() && l.unit == unit && l.worker == worker; });
   if (job.is_done(unit)) {
     ++job.duplicates;
     ++s.counters.duplicates;
@@ -302,11 +298,7 @@ Status Coordinator::fail_lease(uint64_t worker, uint64_t lease, const json& body
     job.phase = JobPhase::Failed;
     job.finished = wall_seconds();
     job.error = "failed on " + std::to_string(job.failures_by_worker.size()) + " worker(s); last error: " + reason;
-    for (auto l = s.leases.begin(); l != s.leases.end();) {
-      auto next = std::next(l);
-      if (l->second.job == job.id()) s.end_lease(l);
-      l = next;
-    }
+    s.end_leases_if([&](const LeaseInfo& l) { return l.job == job.id(); });
     log_event(spdlog::level::err, "job.failed", {{"job", job.id()}, {"reason", job.error}});
   }
   try {
@@ -322,11 +314,7 @@ Status Coordinator::sign_off(uint64_t worker, const json& body) {
   std::lock_guard<std::mutex> lock(s.mu);
   WorkerInfo* w = s.find_worker(worker);
   if (!w) return unknown_worker(worker);
-  for (auto l = s.leases.begin(); l != s.leases.end();) {
-    auto next = std::next(l);
-    if (l->second.worker == worker) s.end_lease(l);
-    l = next;
-  }
+  s.end_leases_if([&](const LeaseInfo& l) { return l.worker == worker; });
   w->state = "gone";
   try {
     s.store.touch_worker(worker, wall_seconds(), "gone");

@@ -206,11 +206,7 @@ json Coordinator::Impl::run_retention(double now) {
         spdlog::warn("retention: cannot delete job {}: {}", j.id, e.what());
         break;
       }
-      for (auto l = leases.begin(); l != leases.end();) {
-        auto next = std::next(l);
-        if (l->second.job == j.id) end_lease(l);
-        l = next;
-      }
+      end_leases_if([&](const LeaseInfo& l) { return l.job == j.id; });
       jobs.erase(it);
       retention.finished_result_bytes.erase(j.id);
       doomed_files.push_back(image_path(j.id));

@@ -37,25 +37,12 @@ struct Region {
   double se() const { return std::sqrt(var_sum) / std::max(n, 1); }
 };
 
-/// The shape that covers pixel (x, y) entirely (centre and four corners), null for pixels that see
-/// only the environment, nothing for silhouette pixels.
-std::optional<const Shape*> cover(const Scene& scene, int x, int y) {
-  std::optional<const Shape*> first;
-  for (Vec2 off : {Vec2(0.5f, 0.5f), Vec2(0.01f, 0.01f), Vec2(0.99f, 0.01f), Vec2(0.01f, 0.99f), Vec2(0.99f, 0.99f)}) {
-    SurfaceInteraction si;
-    const Shape* s = scene.intersect(scene.camera->generate_ray(Vec2(x + off.x, y + off.y), {}), si) ? si.shape : nullptr;
-    if (first && *first != s) return std::nullopt;
-    first = s;
-  }
-  return first;
-}
-
 /// Green channel statistics of the pixels `shape` covers entirely.
 Region pixels_of(const Scene& scene, const Film& film, const Shape* shape) {
   Region r;
   for (int y = 0; y < film.height(); ++y)
     for (int x = 0; x < film.width(); ++x) {
-      auto c = cover(scene, x, y);
+      auto c = test::cover(scene, x, y);
       if (!c || *c != shape) continue;
       const double v = film.mean({x, y}).g;
       r.sum += v;

@@ -41,19 +41,6 @@ Film render_furnace(Scene& scene, int rr_depth = 5) {
   return render(scene, render_settings(32, 5));
 }
 
-// The shape that covers pixel (x, y) entirely (its centre and four corners see it first), null
-// for pixels that see the environment only; nothing for pixels on silhouettes.
-std::optional<const Shape*> cover(const Scene& scene, int x, int y) {
-  std::optional<const Shape*> first;
-  for (Vec2 off : {Vec2(0.5f, 0.5f), Vec2(0.01f, 0.01f), Vec2(0.99f, 0.01f), Vec2(0.01f, 0.99f), Vec2(0.99f, 0.99f)}) {
-    SurfaceInteraction si;
-    const Shape* s = scene.intersect(scene.camera->generate_ray(Vec2(x + off.x, y + off.y), {}), si) ? si.shape : nullptr;
-    if (first && *first != s) return std::nullopt;
-    first = s;
-  }
-  return first;
-}
-
 struct Stats {
   double sum = 0, worst = 0;  // worst: largest |pixel - expected|
   double var_sum = 0;         // sum over pixels of the variance of the pixel's mean

@@ -11,6 +11,7 @@
 
 #include <cmath>
 #include <memory>
+#include <optional>
 
 namespace tessera::test {
 
@@ -63,6 +64,19 @@ inline RenderSettings render_settings(int spp, uint32_t seed = 1, int tile_size 
   s.threads = 2;
   s.tile_size = tile_size;
   return s;
+}
+
+/// The shape that covers pixel (x, y) entirely (its centre and four corners see it first), null
+/// for pixels that see the environment only; nothing for pixels on silhouettes.
+inline std::optional<const Shape*> cover(const Scene& scene, int x, int y) {
+  std::optional<const Shape*> first;
+  for (Vec2 off : {Vec2(0.5f, 0.5f), Vec2(0.01f, 0.01f), Vec2(0.99f, 0.01f), Vec2(0.01f, 0.99f), Vec2(0.99f, 0.99f)}) {
+    SurfaceInteraction si;
+    const Shape* s = scene.intersect(scene.camera->generate_ray(Vec2(x + off.x, y + off.y), {}), si) ? si.shape : nullptr;
+    if (first && *first != s) return std::nullopt;
+    first = s;
+  }
+  return first;
 }
 
 }  // namespace tessera::test
