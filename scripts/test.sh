@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Builds Tessera and runs every test: the Release suite, then the loader fuzz test and the farm's
-# input decoders under AddressSanitizer/UBSan. Usage: scripts/test.sh   (from anywhere; installs packages if missing)
+# Builds Tessera and runs every test: the Release suite (8-wide AVX2 BVH), then the loader fuzz
+# test, the farm's input decoders and the BVH tests under AddressSanitizer/UBSan in the other SIMD
+# baseline (TESSERA_SIMD=sse2: 4-wide BVH), so both widths are tested. Usage: scripts/test.sh   (from anywhere; installs packages if missing)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -12,8 +13,9 @@ cmake --build build -j"$jobs"
 ctest --test-dir build --output-on-failure -LE fuzz -j1
 
 # Sanitizer build: the loader fuzz test, and the farm's decoders of untrusted bytes (bundles, tile
-# results, JSON settings) under AddressSanitizer/UBSan too.
-cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTESSERA_SANITIZE=ON
-cmake --build build-asan -j"$jobs" --target loader_fuzz_test farm_test
+# results, JSON settings) under AddressSanitizer/UBSan too; built for SSE2, so the BVH tests (against
+# brute force and Embree's answers) also cover the 4-wide nodes.
+cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTESSERA_SANITIZE=ON -DTESSERA_SIMD=sse2
+cmake --build build-asan -j"$jobs" --target loader_fuzz_test farm_test accel_test
 ctest --test-dir build-asan --output-on-failure -L fuzz
-ctest --test-dir build-asan --output-on-failure -R '^farm_test$'
+ctest --test-dir build-asan --output-on-failure -R '^(farm_test|accel_test)$'

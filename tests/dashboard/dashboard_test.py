@@ -252,6 +252,11 @@ def run(args, tmp):
         token.send_keys(CLIENT_TOKEN)
         driver.find_element(By.CSS_SELECTOR, "#token-form button[type=submit]").click()
         wait_for(driver, 20, "the banner to go", lambda d: not d.find_element(By.ID, "banner").is_displayed())
+        # The page kept polling until the token was in: those refusals may be logged only now. Drain
+        # them here, so the final check sees only what happened with the token.
+        for entry in severe(driver.get_log("browser")):
+            check(entry.get("source") == "network" and "401" in entry.get("message", ""),
+                  f"console error while entering the token: {entry}")
         check(driver.execute_script("return sessionStorage.getItem('tessera.client_token')") == CLIENT_TOKEN,
               "the token is not in sessionStorage")
 

@@ -1,189 +1,267 @@
-// BVH traversal: closest hit and any hit. No allocation, no exceptions.
+// Wide BVH traversal: closest hit and any hit. No allocation, no exceptions.
 //
-// At an interior node both children's boxes are tested; the nearer hit child (by box entry
-// distance) is visited first and the other pushed with its entry distance, so a popped subtree
-// entered beyond the closest hit so far is skipped without touching its node. (Ordering by the
-// direction's sign on the node's split axis needs no comparison, but once both boxes are tested the
-// entry distances are free, order better, and make the pop-time culling possible; on the bathroom
-// rays this was as fast for primary rays and about 5% faster for diffuse and shadow rays.)
+// One SIMD slab test covers a node's children (AVX for 8-wide nodes, SSE2 for 4-wide: bvh.h). The children hit are visited nearest first
+// (by box entry distance); the others are pushed with their entry distance, so a popped subtree
+// entered beyond the closest hit so far is skipped without touching its node (as Embree's single-
+// ray traversal does).
 // The slab test is the robust one of Ize, "Robust BVH Ray Traversal" (JCGT 2013), as in pbrt-v4:
-// each slab distance carries at most three roundings, so scaling the exit distance by 1 + 2 gamma(3)
+// each slab distance carries at most three roundings, so scaling the exit distances by 1 + 2 gamma(3)
 // keeps every box the ray truly crosses, and a watertight triangle hit is never culled by its box.
-#include "accel/intersect_inline.h"
+// A zero direction component has an infinite reciprocal, and its slab distance is 0 * inf = NaN
+// when the origin lies on that slab's plane (the ray runs inside the plane, so the slab does not
+// bound it). maxps/minps return their second operand when either is NaN, and the second operand is
+// always the running tmin/tmax side, so a NaN slab is dropped, never propagated.
+#include "accel/tri4_inline.h"
 #include "tessera/accel/bvh.h"
 #include "tessera/core/check.h"
 
-#include <cstddef>
+#include <immintrin.h>
 
 namespace tessera {
 using namespace accel_detail;
 
 namespace {
 
-constexpr int kStackSize = 64;
-constexpr float kExitScale = 1.f + 2.f * gamma(3);
+constexpr int W = BvhNode::kWidth;
+// W - 1 pushes a level at most; the binary tree it came from is at most ~60 levels deep.
+constexpr int kStackSize = 64 * (W - 1);
 
-/// Per-ray constants of the slab test. The sign of each direction component decides which of
-/// a box's two planes the ray meets first, so the test reads the near and far plane directly instead
-/// of ordering the two slab distances with min/max.
+/// The few SIMD operations of the slab test, W lanes wide.
+#if defined(__AVX2__)
+using VFloat = __m256;
+inline VFloat vset1(float f) { return _mm256_set1_ps(f); }
+inline VFloat vload(const float* p) { return _mm256_load_ps(p); }
+inline VFloat vsub(VFloat a, VFloat b) { return _mm256_sub_ps(a, b); }
+inline VFloat vmul(VFloat a, VFloat b) { return _mm256_mul_ps(a, b); }
+inline VFloat vmax(VFloat a, VFloat b) { return _mm256_max_ps(a, b); }
+inline VFloat vmin(VFloat a, VFloat b) { return _mm256_min_ps(a, b); }
+inline int vle_mask(VFloat a, VFloat b) { return _mm256_movemask_ps(_mm256_cmp_ps(a, b, _CMP_LE_OQ)); }
+inline void vstore(float* p, VFloat a) { _mm256_store_ps(p, a); }
+#else
+using VFloat = __m128;
+inline VFloat vset1(float f) { return _mm_set1_ps(f); }
+inline VFloat vload(const float* p) { return _mm_load_ps(p); }
+inline VFloat vsub(VFloat a, VFloat b) { return _mm_sub_ps(a, b); }
+inline VFloat vmul(VFloat a, VFloat b) { return _mm_mul_ps(a, b); }
+inline VFloat vmax(VFloat a, VFloat b) { return _mm_max_ps(a, b); }
+inline VFloat vmin(VFloat a, VFloat b) { return _mm_min_ps(a, b); }
+inline int vle_mask(VFloat a, VFloat b) { return _mm_movemask_ps(_mm_cmple_ps(a, b)); }
+inline void vstore(float* p, VFloat a) { _mm_store_ps(p, a); }
+#endif
+static_assert(sizeof(VFloat) == W * sizeof(float));
+// The exit distances use a reciprocal pre-multiplied by the scale: one rounding more on the far
+// side than pbrt-v4's (far - o) * inv * scale, so the bound is 2 gamma(4) instead of 2 gamma(3).
+constexpr float kExitScale = 1.f + 2.f * gamma(4);
+
+/// Per-ray constants of the slab test: which row of BvhNode::bounds is the near plane on each
+/// axis (lo when the direction component is positive), origin and reciprocal direction broadcast.
 struct BoxRay {
-  Vec3 o, inv;
-  int near[3], far[3];  // index of the near/far plane coordinate in the node's floats (see below)
-};
-
-// A node read as floats: lo.x lo.y lo.z [offset] hi.x hi.y hi.z [count, axis, pad].
-static_assert(offsetof(BvhNode, lo) == 0 && offsetof(BvhNode, hi) == 4 * sizeof(float));
-
-inline BoxRay make_box_ray(const Ray& ray) {
-  BoxRay r{ray.o, Vec3(1.f / ray.d.x, 1.f / ray.d.y, 1.f / ray.d.z), {}, {}};
-  for (int a = 0; a < 3; ++a) {
-    r.near[a] = r.inv[a] < 0.f ? 4 + a : a;
-    r.far[a] = r.inv[a] < 0.f ? a : 4 + a;
+  VFloat o[3], inv[3], inv_far[3];
+  int near[3];  // row of the near plane; the far plane is near ^ 1
+  static BoxRay make(const Ray& ray) {
+    BoxRay r;
+    for (int a = 0; a < 3; ++a) {
+      const float inv = 1.f / ray.d[a];
+      r.o[a] = vset1(ray.o[a]);
+      r.inv[a] = vset1(inv);
+      r.inv_far[a] = vset1(inv * kExitScale);
+      r.near[a] = 2 * a + (inv < 0.f ? 1 : 0);
+    }
+    return r;
   }
-  return r;
-}
-
-/// True when the node box overlaps the ray segment [tmin, tmax]; `tnear` gets the entry distance.
-///
-/// A zero direction component has an infinite reciprocal, and its slab distance is 0 * inf = NaN
-/// when the origin lies exactly on that slab's plane (the ray runs inside the plane). std::max(a, b)
-/// is (a < b) ? b : a and std::min(a, b) is (b < a) ? b : a, so with tmin and tmax (never NaN)
-/// taking part as below, a NaN is dropped rather than propagated; it may take one other slab with
-/// it, which only makes the test more conservative.
-inline bool hit_box(const BvhNode& n, const BoxRay& r, float tmin, float tmax, float& tnear) {
-  const float* f = &n.lo.x;
-  const float tx0 = (f[r.near[0]] - r.o.x) * r.inv.x, tx1 = (f[r.far[0]] - r.o.x) * r.inv.x;
-  const float ty0 = (f[r.near[1]] - r.o.y) * r.inv.y, ty1 = (f[r.far[1]] - r.o.y) * r.inv.y;
-  const float tz0 = (f[r.near[2]] - r.o.z) * r.inv.z, tz1 = (f[r.far[2]] - r.o.z) * r.inv.z;
-  const float t0 = std::max(std::max(tmin, tx0), std::max(ty0, tz0));
-  const float exit = std::min(tx1, std::min(ty1, tz1));
-  const float t1 = std::min(tmax, exit * kExitScale);
-  tnear = t0;
-  return t0 <= t1;
-}
-
-/// The BVH's arrays, passed to the traversal kernels (which are templates on the triangle test's
-/// projection axis, so they cannot be declared in the public header).
-struct BvhView {
-  const BvhNode* nodes;
-  const uint32_t* order;
-  const std::array<Vec3, 3>* tris;
-  const SpherePrim* spheres;
-  uint32_t num_triangles;
-  bool triangles_only;
 };
 
-/// A hit leaf child's triangles will be needed soon: start loading them while the traversal goes
-/// on (a few percent faster on the bathroom rays, where the tree does not fit in cache).
-inline void prefetch_leaf(const BvhView& v, const BvhNode& n) {
-  if (n.count == 0) return;
-  __builtin_prefetch(&v.tris[n.offset]);
-  __builtin_prefetch(&v.tris[n.offset + n.count - 1][2]);
+/// Mask of the children whose box overlaps [tmin, tmax]; `tnear` gets their entry distances.
+inline int hit_children(const BvhNode& n, const BoxRay& r, VFloat tmin, VFloat tmax, float tnear[W]) {
+  const VFloat nx = vmul(vsub(vload(n.bounds[r.near[0]]), r.o[0]), r.inv[0]);
+  const VFloat ny = vmul(vsub(vload(n.bounds[r.near[1]]), r.o[1]), r.inv[1]);
+  const VFloat nz = vmul(vsub(vload(n.bounds[r.near[2]]), r.o[2]), r.inv[2]);
+  const VFloat fx = vmul(vsub(vload(n.bounds[r.near[0] ^ 1]), r.o[0]), r.inv_far[0]);
+  const VFloat fy = vmul(vsub(vload(n.bounds[r.near[1] ^ 1]), r.o[1]), r.inv_far[1]);
+  const VFloat fz = vmul(vsub(vload(n.bounds[r.near[2] ^ 1]), r.o[2]), r.inv_far[2]);
+  const VFloat t0 = vmax(nx, vmax(ny, vmax(nz, tmin)));
+  const VFloat t1 = vmin(fx, vmin(fy, vmin(fz, tmax)));
+  vstore(tnear, t0);
+  return vle_mask(t0, t1);
 }
 
-template <int kz, bool kAnyHit>
-bool traverse(const BvhView& v, const Ray& ray, Hit& hit) {
-  const WatertightRay wr = WatertightRay::make<kz>(ray);
-  const BoxRay br = make_box_ray(ray);
-  const float tmin = ray.tmin;
-  float tmax = ray.tmax;
+struct Entry {
+  uint32_t ref;
   float tnear;
-  if (!hit_box(v.nodes[0], br, tmin, tmax, tnear)) return false;
+};
 
-  struct Entry {
-    uint32_t node;
-    float tnear;
-  };
+/// Starts loading what a hit child will need: an interior node's cache lines, or a leaf's first
+/// packet. The tree does not fit in cache for real scenes, and a child is usually visited soon.
+template <class Leaves>
+inline void prefetch_child(const BvhNode* nodes, const Leaves& leaves, uint32_t ref) {
+  if (bvh_ref::is_leaf(ref)) {
+    leaves.prefetch(ref);
+    return;
+  }
+  const char* p = reinterpret_cast<const char*>(nodes + ref);
+  for (size_t line = 0; line < sizeof(BvhNode); line += 64) __builtin_prefetch(p + line);
+}
+
+/// Pushes the hit children of a node; returns the nearest to visit next (the others on the stack,
+/// nearer ones above farther ones).
+inline uint32_t order_children(const BvhNode& node, int mask, const float tnear[W], Entry* stack, int& sp) {
+  const int i = __builtin_ctz(unsigned(mask));
+  mask &= mask - 1;
+  if (mask == 0) return node.child[i];
+  const int j = __builtin_ctz(unsigned(mask));
+  mask &= mask - 1;
+  if (mask == 0) {
+    if (tnear[j] < tnear[i]) {
+      stack[sp++] = {node.child[i], tnear[i]};
+      return node.child[j];
+    }
+    stack[sp++] = {node.child[j], tnear[j]};
+    return node.child[i];
+  }
+  // Three or more: push all, insertion-sort them by decreasing distance, take the nearest.
+  const int base = sp;
+  stack[sp++] = {node.child[i], tnear[i]};
+  stack[sp++] = {node.child[j], tnear[j]};
+  while (mask) {
+    const int k = __builtin_ctz(unsigned(mask));
+    mask &= mask - 1;
+    stack[sp++] = {node.child[k], tnear[k]};
+  }
+  for (int a = base + 1; a < sp; ++a) {
+    const Entry e = stack[a];
+    int b = a - 1;
+    for (; b >= base && stack[b].tnear < e.tnear; --b) stack[b + 1] = stack[b];
+    stack[b + 1] = e;
+  }
+  return stack[--sp].ref;
+}
+
+/// Triangles: leaves are runs of Tri4 packets.
+template <int kz, bool kAnyHit>
+struct TriangleLeaves {
+  const Tri4* packets;
+  WatertightRay wr;
+  WatertightRay4 r4;
+  TriangleLeaves(const Tri4* p, const Ray& ray) : packets(p), wr(WatertightRay::make<kz>(ray)), r4(WatertightRay4::make(wr)) {}
+  void prefetch(uint32_t ref) const {
+    const char* p = reinterpret_cast<const char*>(packets + bvh_ref::leaf_first(ref));
+    __builtin_prefetch(p);
+    __builtin_prefetch(p + 64);
+    __builtin_prefetch(p + 128);
+  }
+  bool intersect(uint32_t ref, const Ray& ray, float& tmax, Hit& hit) const {
+    const Tri4* p = packets + bvh_ref::leaf_first(ref);
+    const uint32_t count = bvh_ref::leaf_count(ref);
+    bool found = false;
+    for (uint32_t k = 0; k < count; ++k) {
+      if (intersect_tri4<kz, kAnyHit>(p[k], wr, r4, ray.tmin, tmax, hit)) {
+        if constexpr (kAnyHit) return true;
+        found = true;
+      }
+    }
+    return found;
+  }
+};
+
+/// Spheres: leaves are runs of the leaf-ordered sphere array.
+template <bool kAnyHit>
+struct SphereLeaves {
+  const SpherePrim* spheres;
+  const uint32_t* order;
+  void prefetch(uint32_t ref) const { __builtin_prefetch(spheres + bvh_ref::leaf_first(ref)); }
+  bool intersect(uint32_t ref, const Ray& ray, float& tmax, Hit& hit) const {
+    const uint32_t first = bvh_ref::leaf_first(ref), end = first + bvh_ref::leaf_count(ref);
+    bool found = false;
+    for (uint32_t i = first; i < end; ++i) {
+      float t;
+      if (!intersect_sphere_inline(ray, spheres[i].center, spheres[i].radius, ray.tmin, tmax, t)) continue;
+      if constexpr (kAnyHit) return true;
+      tmax = t;
+      hit.t = t;
+      hit.prim = order[i];
+      hit.b1 = hit.b2 = 0.f;
+      found = true;
+    }
+    return found;
+  }
+};
+
+template <bool kAnyHit, class Leaves>
+bool traverse(const BvhNode* nodes, const Leaves& leaves, const Ray& ray, float& tmax, Hit& hit) {
+  const BoxRay br = BoxRay::make(ray);
+  const VFloat tmin_v = vset1(ray.tmin);
   Entry stack[kStackSize];
   int sp = 0;
-  uint32_t current = 0;
+  uint32_t ref = 0;
   bool found = false;
+  alignas(32) float tnear[W];
   for (;;) {
-    const BvhNode& node = v.nodes[current];
-    if (node.count == 0) {
-      uint32_t a = current + 1, b = node.offset;
-      float ta, tb;
-      const bool hit_a = hit_box(v.nodes[a], br, tmin, tmax, ta);
-      const bool hit_b = hit_box(v.nodes[b], br, tmin, tmax, tb);
-      if (hit_a) prefetch_leaf(v, v.nodes[a]);
-      if (hit_b) prefetch_leaf(v, v.nodes[b]);
-      if (hit_a && hit_b) {
-        if (tb < ta) {
-          std::swap(a, b);
-          std::swap(ta, tb);
+    while (!bvh_ref::is_leaf(ref)) {
+      const BvhNode& node = nodes[ref];
+      int mask = hit_children(node, br, tmin_v, vset1(tmax), tnear);
+      if (mask == 0) goto pop;
+      for (int m = mask; m; m &= m - 1) prefetch_child(nodes, leaves, node.child[__builtin_ctz(unsigned(m))]);
+      TESSERA_DCHECK(sp + W <= kStackSize);
+      if constexpr (kAnyHit) {
+        // Any hit ends the search, so there is no closest hit to cull with: skip the sort.
+        ref = node.child[__builtin_ctz(unsigned(mask))];
+        for (mask &= mask - 1; mask; mask &= mask - 1) {
+          const int k = __builtin_ctz(unsigned(mask));
+          stack[sp++] = {node.child[k], tnear[k]};
         }
-        TESSERA_DCHECK(sp < kStackSize);
-        stack[sp++] = {b, tb};
-        current = a;
-        continue;
-      }
-      if (hit_a) {
-        current = a;
-        continue;
-      }
-      if (hit_b) {
-        current = b;
-        continue;
-      }
-    } else {
-      const uint32_t end = node.offset + node.count;
-      for (uint32_t i = node.offset; i < end; ++i) {
-        float t, b1 = 0.f, b2 = 0.f;
-        bool h;
-        if (v.triangles_only || v.order[i] < v.num_triangles) {
-          const auto& tri = v.tris[i];
-          h = intersect_triangle_k<kz>(wr, tri[0], tri[1], tri[2], tmin, tmax, t, b1, b2);
-        } else {
-          const SpherePrim& s = v.spheres[v.order[i] - v.num_triangles];
-          h = intersect_sphere_inline(ray, s.center, s.radius, tmin, tmax, t);
-        }
-        if (h) {
-          if constexpr (kAnyHit) return true;
-          tmax = t;
-          hit.t = t;
-          hit.prim = v.order[i];
-          hit.b1 = b1;
-          hit.b2 = b2;
-          found = true;
-        }
+      } else {
+        ref = order_children(node, mask, tnear, stack, sp);
       }
     }
-    // Pop the next subtree, skipping those entered beyond the closest hit found so far.
-    for (;;) {
+    if (leaves.intersect(ref, ray, tmax, hit)) {
+      if constexpr (kAnyHit) return true;
+      found = true;
+    }
+  pop:
+    // The next subtree, skipping those entered beyond the closest hit found so far.
+    do {
       if (sp == 0) return found;
       --sp;
-      if (stack[sp].tnear <= tmax) {
-        current = stack[sp].node;
-        break;
-      }
-    }
+    } while (stack[sp].tnear > tmax);
+    ref = stack[sp].ref;
   }
 }
 
 template <bool kAnyHit>
-bool dispatch(const BvhView& v, const Ray& ray, Hit& hit) {
-  switch (watertight_axis(ray.d)) {
-    case 0: return traverse<0, kAnyHit>(v, ray, hit);
-    case 1: return traverse<1, kAnyHit>(v, ray, hit);
-    default: return traverse<2, kAnyHit>(v, ray, hit);
+bool trace_all(const BvhNode* tri_nodes, const Tri4* packets, const BvhNode* sphere_nodes,
+               const SpherePrim* spheres, const uint32_t* sphere_order, const Ray& ray, Hit& hit) {
+  float tmax = ray.tmax;
+  bool found = false;
+  if (tri_nodes) {
+    bool h;
+    switch (watertight_axis(ray.d)) {
+      case 0: h = traverse<kAnyHit>(tri_nodes, TriangleLeaves<0, kAnyHit>(packets, ray), ray, tmax, hit); break;
+      case 1: h = traverse<kAnyHit>(tri_nodes, TriangleLeaves<1, kAnyHit>(packets, ray), ray, tmax, hit); break;
+      default: h = traverse<kAnyHit>(tri_nodes, TriangleLeaves<2, kAnyHit>(packets, ray), ray, tmax, hit); break;
+    }
+    if (h) {
+      if constexpr (kAnyHit) return true;
+      found = true;
+    }
   }
+  if (sphere_nodes && traverse<kAnyHit>(sphere_nodes, SphereLeaves<kAnyHit>{spheres, sphere_order}, ray, tmax, hit))
+    found = true;
+  return found;
 }
 
 }  // namespace
 
 bool Bvh::intersect(const Ray& ray, Hit& hit) const {
-  if (nodes_.empty()) return false;
-  const BvhView v{nodes_.data(), prim_order_.data(), tris_.data(), spheres_.data(), num_triangles_,
-                  spheres_.empty()};
-  return dispatch<false>(v, ray, hit);
+  return trace_all<false>(tri_nodes_.empty() ? nullptr : tri_nodes_.data(), packets_.data(),
+                          sphere_nodes_.empty() ? nullptr : sphere_nodes_.data(), leaf_spheres_.data(),
+                          sphere_order_.data(), ray, hit);
 }
 
 bool Bvh::occluded(const Ray& ray) const {
-  if (nodes_.empty()) return false;
-  const BvhView v{nodes_.data(), prim_order_.data(), tris_.data(), spheres_.data(), num_triangles_,
-                  spheres_.empty()};
   Hit unused;
-  return dispatch<true>(v, ray, unused);
+  return trace_all<true>(tri_nodes_.empty() ? nullptr : tri_nodes_.data(), packets_.data(),
+                         sphere_nodes_.empty() ? nullptr : sphere_nodes_.data(), leaf_spheres_.data(),
+                         sphere_order_.data(), ray, unused);
 }
 
 }  // namespace tessera

@@ -41,6 +41,29 @@ struct WatertightRay {
   }
 };
 
+/// The edge functions again when a float one came out zero: a float zero may be a rounded
+/// non-zero, so decide the sign exactly (products of floats are exact in double, and so is the
+/// difference of two of them up to one rounding).
+inline void exact_edges(float ax, float ay, float bx, float by, float cx, float cy, float& e0, float& e1,
+                        float& e2) {
+  e0 = float(double(bx) * double(cy) - double(by) * double(cx));
+  e1 = float(double(cx) * double(ay) - double(cy) * double(ax));
+  e2 = float(double(ax) * double(by) - double(ay) * double(bx));
+}
+
+/// Distance along the ray to the triangle's plane: dot(n, p0 - o) / dot(n, d) in double, where the
+/// vertex differences and the cross product are (nearly) exact. NaN when the ray is parallel to the
+/// plane, so that every range test rejects it.
+inline float plane_distance(const WatertightRay& r, const Vec3& p0, const Vec3& p1, const Vec3& p2) {
+  const double e1x = double(p1.x) - p0.x, e1y = double(p1.y) - p0.y, e1z = double(p1.z) - p0.z;
+  const double e2x = double(p2.x) - p0.x, e2y = double(p2.y) - p0.y, e2z = double(p2.z) - p0.z;
+  const double nx = e1y * e2z - e1z * e2y, ny = e1z * e2x - e1x * e2z, nz = e1x * e2y - e1y * e2x;
+  const double denom = nx * r.d[0] + ny * r.d[1] + nz * r.d[2];
+  if (denom == 0.0) return std::numeric_limits<float>::quiet_NaN();
+  const double num = nx * (double(p0.x) - r.o.x) + ny * (double(p0.y) - r.o.y) + nz * (double(p0.z) - r.o.z);
+  return float(num / denom);
+}
+
 /// Watertight ray/triangle test; accepts t in (tmin, tmax].
 ///
 /// Inside/outside comes from Woop, Benthin and Wald: edge functions evaluated in a frame where the
@@ -48,9 +71,9 @@ struct WatertightRay {
 /// vertex of a closed mesh hits at least one of the triangles. The distance does not come from the
 /// sheared z (its error grows with the triangle's size over t, which made pbrt-v4's conservative
 /// t > 0 bound reject real hits on long slivers seen at grazing angles, and put t off by 1e-3
-/// relative on short rays): it is the plane distance dot(n, p0 - o) / dot(n, d) evaluated in double,
-/// where the vertex differences and the cross product are (nearly) exact, so t is accurate to a few
-/// double ULPs of the float triangle. Only candidates that pass the edge test pay for it.
+/// relative on short rays): it is plane_distance, accurate to a few double ULPs of the float
+/// triangle. Only candidates that pass the edge test pay for it. The 4-wide test (tri4_inline.h)
+/// performs the same float operations lane by lane, so both give the same bits.
 template <int kz>
 inline bool intersect_triangle_k(const WatertightRay& r, const Vec3& p0, const Vec3& p1, const Vec3& p2,
                                  float tmin, float tmax, float& t_out, float& b1_out, float& b2_out) {
@@ -64,24 +87,13 @@ inline bool intersect_triangle_k(const WatertightRay& r, const Vec3& p0, const V
   float e0 = bx * cy - by * cx;
   float e1 = cx * ay - cy * ax;
   float e2 = ax * by - ay * bx;
-  if (e0 == 0.f || e1 == 0.f || e2 == 0.f) [[unlikely]] {
-    // A float zero may be a rounded non-zero: decide the sign exactly (products of floats are
-    // exact in double, and so is the difference of two of them up to one rounding).
-    e0 = float(double(bx) * double(cy) - double(by) * double(cx));
-    e1 = float(double(cx) * double(ay) - double(cy) * double(ax));
-    e2 = float(double(ax) * double(by) - double(ay) * double(bx));
-  }
+  if (e0 == 0.f || e1 == 0.f || e2 == 0.f) [[unlikely]]
+    exact_edges(ax, ay, bx, by, cx, cy, e0, e1, e2);
   if ((e0 < 0.f || e1 < 0.f || e2 < 0.f) && (e0 > 0.f || e1 > 0.f || e2 > 0.f)) return false;
   const float det = e0 + e1 + e2;
   if (det == 0.f) return false;
 
-  const double e1x = double(p1.x) - p0.x, e1y = double(p1.y) - p0.y, e1z = double(p1.z) - p0.z;
-  const double e2x = double(p2.x) - p0.x, e2y = double(p2.y) - p0.y, e2z = double(p2.z) - p0.z;
-  const double nx = e1y * e2z - e1z * e2y, ny = e1z * e2x - e1x * e2z, nz = e1x * e2y - e1y * e2x;
-  const double denom = nx * r.d[0] + ny * r.d[1] + nz * r.d[2];
-  if (denom == 0.0) return false;
-  const double num = nx * (double(p0.x) - r.o.x) + ny * (double(p0.y) - r.o.y) + nz * (double(p0.z) - r.o.z);
-  const float t = float(num / denom);
+  const float t = plane_distance(r, p0, p1, p2);
   if (!(t > tmin) || t > tmax) return false;
 
   const float inv_det = 1.f / det;

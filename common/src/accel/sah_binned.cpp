@@ -131,7 +131,9 @@ BinMapper::BinMapper(const Bounds3& centroids, int bins) : num_bins(bins) {
 }
 
 SahSplit find_sah_split(const PrimRef* refs, size_t n, const Bounds3& bounds, const BinMapper& mapper,
-                        bool parallel) {
+                        uint32_t block_shift, bool parallel) {
+  const uint32_t round = (1u << block_shift) - 1;
+  const auto blocks = [&](uint32_t count) { return float((count + round) >> block_shift); };
   const int nb = mapper.num_bins;
   Bins bins(nb);
   if (!parallel || n <= kReduceChunk) {
@@ -158,7 +160,7 @@ SahSplit find_sah_split(const PrimRef* refs, size_t n, const Bounds3& bounds, co
     for (int b = nb - 1; b > 0; --b) {
       acc.extend(bins.box[axis][b]);
       count += bins.count[axis][b];
-      right_cost[b - 1] = float(count) * acc.area();
+      right_cost[b - 1] = blocks(count) * acc.area();
       right_count[b - 1] = count;
     }
     acc = Box4{};
@@ -167,7 +169,7 @@ SahSplit find_sah_split(const PrimRef* refs, size_t n, const Bounds3& bounds, co
       acc.extend(bins.box[axis][b]);
       count += bins.count[axis][b];
       if (count == 0 || right_count[b] == 0) continue;
-      const float cost = kTraversalCost + (float(count) * acc.area() + right_cost[b]) * inv_area;
+      const float cost = kTraversalCost + (blocks(count) * acc.area() + right_cost[b]) * inv_area;
       if (!best.valid || cost < best.cost) best = SahSplit{true, axis, b, cost};
     }
   }
