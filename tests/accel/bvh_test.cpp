@@ -113,7 +113,9 @@ TEST(Bvh, MatchesBruteForceCoincidentCentroids) {
   const Bvh bvh = Bvh::build(tris, {});
   for (const BvhNode& n : bvh.tri_nodes())
     for (uint32_t ref : n.child)
-      if (bvh_ref::is_leaf(ref)) EXPECT_LE(bvh_ref::leaf_count(ref), 2u);  // at most 8 triangles
+      if (bvh_ref::is_leaf(ref)) {
+        EXPECT_LE(bvh_ref::leaf_count(ref), 2u);  // at most 8 triangles
+      }
   for (int i = 0; i < 500; ++i) {
     Ray ray{test::random_in_box(rng, -2.f, 2.f), test::random_unit(rng)};
     Hit e, g;
@@ -202,7 +204,9 @@ uint32_t check_wide(const NodeArray& nodes, uint32_t node, const Bounds3& box, i
     }
     EXPECT_GT(ref, node);
     EXPECT_LT(ref, nodes.size());
-    if (first_interior) EXPECT_EQ(ref, node + 1);
+    if (first_interior) {
+      EXPECT_EQ(ref, node + 1);
+    }
     first_interior = false;
     covered += check_wide(nodes, ref, child, depth + 1, next_slot, leaf_box);
   }

@@ -122,7 +122,6 @@ Bvh Bvh::build(std::vector<std::array<Vec3, 3>> triangles, std::vector<SpherePri
     }
   });
   bvh.tri_nodes_ = collapse_to_wide(tri_binary, tri_slots.refs);
-  bvh.num_triangles_in_tree_ = tri_refs.size();
 
   // Spheres: one leaf-order array.
   const HugeVector<BinaryNode> sphere_binary = build_binary(sphere_refs, 1);
@@ -147,7 +146,7 @@ struct TreeStats {
   double cost = 0;  // sum of area * cost, not yet divided by the root area
 };
 
-/// `leaf_cost(ref)`: tests a leaf costs (packets or spheres).
+/// Leaves, depth and SAH cost of one wide tree; a leaf costs one test per packet (or sphere).
 TreeStats tree_stats(const NodeArray& nodes) {
   TreeStats s;
   if (nodes.empty()) return s;
@@ -186,7 +185,10 @@ BvhStats Bvh::stats() const {
   BvhStats s;
   s.nodes = tri_nodes_.size() + sphere_nodes_.size();
   s.packets = packets_.size();
-  s.primitives = num_triangles_in_tree_ + leaf_spheres_.size();
+  size_t triangles = 0;
+  for (const Tri4& p : packets_)
+    for (uint32_t prim : p.prim) triangles += prim != Tri4::kNoPrim ? 1 : 0;
+  s.primitives = triangles + leaf_spheres_.size();
   s.bytes = s.nodes * sizeof(BvhNode) + packets_.size() * sizeof(Tri4) +
             leaf_spheres_.size() * (sizeof(SpherePrim) + sizeof(uint32_t));
   const TreeStats t = tree_stats(tri_nodes_), sp = tree_stats(sphere_nodes_);

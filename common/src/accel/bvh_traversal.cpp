@@ -187,8 +187,7 @@ struct SphereLeaves {
 };
 
 template <bool kAnyHit, class Leaves>
-bool traverse(const BvhNode* nodes, const Leaves& leaves, const Ray& ray, float& tmax, Hit& hit) {
-  const BoxRay br = BoxRay::make(ray);
+bool traverse(const BvhNode* nodes, const Leaves& leaves, const Ray& ray, const BoxRay& br, float& tmax, Hit& hit) {
   const VFloat tmin_v = vset1(ray.tmin);
   Entry stack[kStackSize];
   int sp = 0;
@@ -227,41 +226,39 @@ bool traverse(const BvhNode* nodes, const Leaves& leaves, const Ray& ray, float&
   }
 }
 
+}  // namespace
+
 template <bool kAnyHit>
-bool trace_all(const BvhNode* tri_nodes, const Tri4* packets, const BvhNode* sphere_nodes,
-               const SpherePrim* spheres, const uint32_t* sphere_order, const Ray& ray, Hit& hit) {
+bool Bvh::trace(const Ray& ray, Hit& hit) const {
+  const BoxRay br = BoxRay::make(ray);  // shared by both trees
   float tmax = ray.tmax;
   bool found = false;
-  if (tri_nodes) {
+  if (!tri_nodes_.empty()) {
+    const BvhNode* nodes = tri_nodes_.data();
+    const Tri4* packets = packets_.data();
     bool h;
     switch (watertight_axis(ray.d)) {
-      case 0: h = traverse<kAnyHit>(tri_nodes, TriangleLeaves<0, kAnyHit>(packets, ray), ray, tmax, hit); break;
-      case 1: h = traverse<kAnyHit>(tri_nodes, TriangleLeaves<1, kAnyHit>(packets, ray), ray, tmax, hit); break;
-      default: h = traverse<kAnyHit>(tri_nodes, TriangleLeaves<2, kAnyHit>(packets, ray), ray, tmax, hit); break;
+      case 0: h = traverse<kAnyHit>(nodes, TriangleLeaves<0, kAnyHit>(packets, ray), ray, br, tmax, hit); break;
+      case 1: h = traverse<kAnyHit>(nodes, TriangleLeaves<1, kAnyHit>(packets, ray), ray, br, tmax, hit); break;
+      default: h = traverse<kAnyHit>(nodes, TriangleLeaves<2, kAnyHit>(packets, ray), ray, br, tmax, hit); break;
     }
     if (h) {
       if constexpr (kAnyHit) return true;
       found = true;
     }
   }
-  if (sphere_nodes && traverse<kAnyHit>(sphere_nodes, SphereLeaves<kAnyHit>{spheres, sphere_order}, ray, tmax, hit))
+  if (!sphere_nodes_.empty() &&
+      traverse<kAnyHit>(sphere_nodes_.data(), SphereLeaves<kAnyHit>{leaf_spheres_.data(), sphere_order_.data()}, ray,
+                        br, tmax, hit))
     found = true;
   return found;
 }
 
-}  // namespace
-
-bool Bvh::intersect(const Ray& ray, Hit& hit) const {
-  return trace_all<false>(tri_nodes_.empty() ? nullptr : tri_nodes_.data(), packets_.data(),
-                          sphere_nodes_.empty() ? nullptr : sphere_nodes_.data(), leaf_spheres_.data(),
-                          sphere_order_.data(), ray, hit);
-}
+bool Bvh::intersect(const Ray& ray, Hit& hit) const { return trace<false>(ray, hit); }
 
 bool Bvh::occluded(const Ray& ray) const {
   Hit unused;
-  return trace_all<true>(tri_nodes_.empty() ? nullptr : tri_nodes_.data(), packets_.data(),
-                         sphere_nodes_.empty() ? nullptr : sphere_nodes_.data(), leaf_spheres_.data(),
-                         sphere_order_.data(), ray, unused);
+  return trace<true>(ray, unused);
 }
 
 }  // namespace tessera

@@ -26,11 +26,13 @@ void SphereShape::sample_area(Vec2 u, Vec3& p, Vec3& n, float& pdf_area) const {
   pdf_area = 1.f / area();
 }
 
-Vec3 SphereShape::reproject(Vec3 p, Vec3& p_error) const {
+Vec3 SphereShape::reproject(Vec3 p, Vec3& p_error, Vec3* unit) const {
   const Vec3 d = p - center_;
   const float l2 = length_squared(d);
   // A point exactly at the centre cannot come from a real hit or sample; guard anyway.
-  const Vec3 q = l2 > 0.f ? (d / std::sqrt(l2)) * radius_ : Vec3(0.f, 0.f, radius_);
+  const Vec3 n = l2 > 0.f ? d / std::sqrt(l2) : Vec3(0.f, 0.f, 1.f);
+  if (unit) *unit = n;
+  const Vec3 q = n * radius_;
   const Vec3 out = center_ + q;
   // q: squares, sum, sqrt, division, product: within gamma(5) of r d/|d| per axis (the error in
   // d only turns it, along the surface). Adding the centre rounds once more.
@@ -41,10 +43,8 @@ Vec3 SphereShape::reproject(Vec3 p, Vec3& p_error) const {
 void SphereShape::fill_interaction(const Ray& ray, const Hit& hit, uint32_t prim,
                                    SurfaceInteraction& si) const {
   // Re-project onto the surface: ray.at(t) carries the error of t (Mitsuba does the same).
-  si.p = reproject(ray.at(hit.t), si.p_error);
-  const Vec3 d = ray.at(hit.t) - center_;
-  const float l2 = length_squared(d);
-  const Vec3 n = l2 > 0.f ? d / std::sqrt(l2) : Vec3(0.f, 0.f, 1.f);
+  Vec3 n;
+  si.p = reproject(ray.at(hit.t), si.p_error, &n);
   si.t = hit.t;
   si.ng = flip_ ? -n : n;
   si.shading = Frame(si.ng);

@@ -110,13 +110,17 @@ class Bvh {
   const std::vector<uint32_t>& sphere_order() const { return sphere_order_; }
 
  private:
+  /// Both traversals (bvh_traversal.cpp): the triangle tree, then the sphere tree with the closest
+  /// distance found so far.
+  template <bool kAnyHit>
+  bool trace(const Ray& ray, Hit& hit) const;
+
   NodeArray tri_nodes_;
   Tri4Array packets_;
   NodeArray sphere_nodes_;
   std::vector<SpherePrim> leaf_spheres_;   // in leaf order
   std::vector<uint32_t> sphere_order_;     // global index of leaf_spheres_[i]
   Bounds3 bounds_;
-  size_t num_triangles_in_tree_ = 0;
 };
 
 /// Watertight ray/triangle test (Woop, Benthin, Wald 2013). Returns true and sets t, b1, b2 when

@@ -108,8 +108,9 @@ class SphereShape final : public Shape {
   Vec3 center() const { return center_; }
   float radius() const { return radius_; }
   /// Projects `p` (near the surface) onto the sphere and bounds the rounding error of the result
-  /// per axis in `p_error` (pbrt-v4's gamma(5) |p - c|, plus the addition of the centre).
-  Vec3 reproject(Vec3 p, Vec3& p_error) const;
+  /// per axis in `p_error` (pbrt-v4's gamma(5) |p - c|, plus the addition of the centre). `unit`,
+  /// when given, gets the unit direction from the centre towards `p` that the projection used.
+  Vec3 reproject(Vec3 p, Vec3& p_error, Vec3* unit = nullptr) const;
 
  private:
   Vec3 center_;
