@@ -10,7 +10,7 @@
 #include "tessera/farm/bundle.h"
 #include "tessera/farm/build_fingerprint.h"
 #include "tessera/render/renderer.h"
-#include "tessera/worker/farm_client.h"
+#include "tessera/client/farm_api.h"
 
 #include <CLI/CLI.hpp>
 
@@ -172,8 +172,8 @@ std::vector<std::string> check_run(ServerProcess& server, uint64_t job, const st
     failures.push_back("the coordinator exited");
     return failures;
   }
-  farm::FarmClient client(server.url());
-  json status = client.get("/api/v1/jobs/" + std::to_string(job), 10).json();
+  client::FarmApi api(client::FarmClient(server.url()));
+  json status = api.job(job, 10).json();
   if (!status.is_object()) {
     failures.push_back("no status for job " + std::to_string(job));
   } else {
@@ -188,7 +188,7 @@ std::vector<std::string> check_run(ServerProcess& server, uint64_t job, const st
     if ((done == total) != (state == "done"))
       failures.push_back("job state '" + state + "' with " + std::to_string(done) + "/" + std::to_string(total) + " units");
   }
-  farm::HttpReply health = client.get("/healthz", 10);
+  client::HttpReply health = api.health(10);
   if (health.status != 200 || health.json().value("status", "") != "ok")
     failures.push_back("/healthz at the end: " + health.describe() + " " + health.body);
   return failures;
@@ -197,14 +197,14 @@ std::vector<std::string> check_run(ServerProcess& server, uint64_t job, const st
 int run(const Options& o) {
   TempDir tmp;
   ServerProcess server(o.server_bin, tmp.path.string(), o.http_threads, o.max_poll_wait);
-  farm::FarmClient client(server.url());
+  client::FarmApi api(client::FarmClient(server.url()));
 
   const JobShape shape = plan_job(o.units);
   if (int(pass_schedule(uint32_t(shape.spp)).size()) != shape.passes) throw std::logic_error("pass plan");
   std::ofstream(tmp.path / "scene.xml") << kScene;
   const json settings = {{"name", "farm-load"}, {"spp", shape.spp}, {"width", shape.tiles_x * o.tile_size},
                          {"height", shape.tiles_y * o.tile_size}, {"tile_size", o.tile_size}};
-  farm::HttpReply submitted = client.post_job_with_bundle(settings, pack_bundle(tmp.path.string(), {"scene.xml"}));
+  client::HttpReply submitted = api.submit_job(settings, pack_bundle(tmp.path.string(), {"scene.xml"}));
   if (submitted.status != 201) throw std::runtime_error("job submission: " + submitted.describe());
   const uint64_t job = submitted.json().value("id", uint64_t(0));
   const uint64_t units_total = submitted.json().value("units_total", uint64_t(0));
@@ -252,7 +252,7 @@ int run(const Options& o) {
   f.upload_p99 = percentile(upload_ms, 0.99);
   std::vector<std::string> failures = check_run(server, job, stats);
   if (server.alive()) {
-    json status = client.get("/api/v1/jobs/" + std::to_string(job), 10).json();
+    json status = api.job(job, 10).json();
     if (status.is_object() && status.value("units_done", uint64_t(0)) > 0)
       f.result_bytes = status.value("result_bytes", uint64_t(0)) * f.units / status.value("units_done", uint64_t(1));
   }

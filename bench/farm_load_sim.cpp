@@ -4,7 +4,7 @@
 #include "tessera/farm/build_fingerprint.h"
 #include "tessera/farm/protocol.h"
 #include "tessera/farm/tile_result.h"
-#include "tessera/worker/farm_client.h"
+#include "tessera/client/farm_api.h"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -48,7 +48,9 @@ ServerProcess::ServerProcess(const std::string& binary, const std::string& dir, 
   std::vector<std::string> args = {binary, "--listen", "127.0.0.1:0", "--port-file", port_file,
                                    "--data-dir", (fs::path(dir) / "data").string(),
                                    "--http-threads", std::to_string(http_threads),
-                                   "--max-poll-wait", std::to_string(max_poll_wait)};
+                                   "--max-poll-wait", std::to_string(max_poll_wait),
+                                   // Each unit leased once: the run checks every lease ends accepted.
+                                   "--no-speculation"};
   std::vector<std::string> env;
   for (char** e = environ; *e; ++e) {
     std::string entry(*e);
@@ -84,7 +86,7 @@ ServerProcess::ServerProcess(const std::string& binary, const std::string& dir, 
   url_ = "http://127.0.0.1:" + std::to_string(port);
   bool healthy = false;
   for (auto end = Clock::now() + std::chrono::seconds(20); port > 0 && !healthy && Clock::now() < end && alive();) {
-    healthy = farm::FarmClient(url_).get("/healthz", 2).status == 200;
+    healthy = client::FarmApi(client::FarmClient(url_)).health(2).status == 200;
     if (!healthy) std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   if (!healthy) {
@@ -184,27 +186,24 @@ void note_error(SimStats& st, const std::string& what) {
 
 // Uploads one result, retrying transport failures and 5xx a few times (the real worker retries
 // for minutes; here a lost upload is a finding).
-void upload(const farm::FarmClient& client, uint64_t worker, const Lease& lease, const std::string& bytes,
+void upload(const client::FarmApi& api, uint64_t worker, const Lease& lease, const std::string& bytes,
             SimShared& shared, SimStats& st) {
-  const std::string path =
-      "/api/v1/workers/" + std::to_string(worker) + "/results?lease=" + std::to_string(lease.id);
   for (int attempt = 0; attempt < 3; ++attempt) {
     const auto t0 = Clock::now();
-    farm::HttpReply r = client.post_bytes(path, bytes, "application/x-tessera-tile", 60);
+    client::ApiReply<client::ResultAck> r = api.upload_result(worker, lease.id, bytes);
     if (r.ok()) {
       st.upload_ms.push_back(ms_since(t0));
-      json j = r.json();
-      if (j.value("duplicate", false)) {
+      if (r.value.duplicate) {
         ++st.duplicates;
-      } else if (j.value("accepted", false)) {
+      } else if (r.value.accepted) {
         ++st.accepted;
         ++shared.accepted;
       } else {
-        note_error(st, "upload answered neither accepted nor duplicate: " + r.body);
+        note_error(st, "upload answered neither accepted nor duplicate: " + r.http.body);
       }
       return;
     }
-    if (r.status != 0 && r.status < 500) {
+    if (r.http.status != 0 && r.http.status < 500) {
       note_error(st, "upload of job " + std::to_string(lease.job_id) + " unit " + std::to_string(lease.tile) + "/" +
                          std::to_string(lease.pass) + " refused: " + r.describe());
       return;
@@ -218,48 +217,41 @@ void upload(const farm::FarmClient& client, uint64_t worker, const Lease& lease,
 
 void run_simulated_worker(int index, SimShared& shared, SimStats& st) {
   try {
-    farm::FarmClient client(shared.url);
+    client::FarmApi api(client::FarmClient(shared.url));
     const BuildFingerprint& fp = build_fingerprint();  // the check the real worker passes
     WorkerHello hello{"load-" + std::to_string(index), 1, uint64_t(1) << 30, fp.version, fp.isa, fp.probe};
-    farm::HttpReply reg = client.post_json("/api/v1/workers", to_json(hello), 30);
-    const uint64_t id = reg.status == 201 ? reg.json().value("id", uint64_t(0)) : 0;
+    client::ApiReply<client::Registration> reg = api.register_worker(hello);
+    const uint64_t id = reg.ok() ? reg.value.id : 0;
     st.registered = id != 0;
     ++shared.registered;
     if (!st.registered) return note_error(st, "registration: " + reg.describe());
     while (!shared.start && !shared.stop) std::this_thread::sleep_for(std::chrono::milliseconds(1));
 
-    const std::string lease_path = "/api/v1/workers/" + std::to_string(id) + "/lease?wait=" +
-                                   std::to_string(shared.poll_wait);
     uint64_t rng = 0x9E3779B97F4A7C15ull * uint64_t(index + 1);
     TileResult result;
     while (!shared.stop) {
       const auto t0 = Clock::now();
-      farm::HttpReply r = client.post_json(lease_path, json::object(), shared.poll_wait + 15);
+      client::ApiReply<std::optional<Lease>> r = api.lease(id, shared.poll_wait, shared.poll_wait + 15);
       const double ms = ms_since(t0);
-      if (r.status == 204) {
+      if (r.ok() && !r.value) {
         ++st.empty_polls;
         // Answered at once: the coordinator's long-poll slots are full; back off as tessera-worker does.
         if (ms < 500) sleep_unless_stopped(shared, 0.25);
         continue;
       }
-      if (r.status != 200) {
+      if (!r.ok()) {
         note_error(st, "lease request: " + r.describe());
         sleep_unless_stopped(shared, 0.1);
         continue;
       }
-      Lease lease;
-      std::string error;
-      if (!lease_from_json(r.json(), lease, error)) {
-        note_error(st, "bad lease: " + error);
-        continue;
-      }
+      const Lease& lease = *r.value;
       st.lease_ms.push_back(ms);
       ++st.leased;
       // A lease taken is completed even when stopping: every unit leased must end accepted.
       fill_synthetic(lease, rng, result);
-      upload(client, id, lease, encode_tile_result(result), shared, st);
+      upload(api, id, lease, encode_tile_result(result), shared, st);
     }
-    farm::HttpReply off = client.del("/api/v1/workers/" + std::to_string(id), json::object(), 10);
+    client::HttpReply off = api.sign_off(id);
     st.signed_off = off.ok();
     if (!off.ok()) note_error(st, "sign-off: " + off.describe());
   } catch (const std::exception& e) {

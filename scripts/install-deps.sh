@@ -1,17 +1,31 @@
 #!/usr/bin/env bash
-# Installs every Debian 12 package Tessera's build and tests need. Idempotent; run as root
-# (or with sudo available). Nothing is downloaded from anywhere but Debian's archive.
+# Installs the Debian 12 packages Tessera needs. Idempotent; run as root (or with sudo available).
+# Nothing is downloaded from anywhere but Debian's archive.
+#   install-deps.sh              build and every test (what CI and scripts/test.sh use)
+#   install-deps.sh --build      only what compiling tessera, tessera-server and tessera-worker needs
+#                                (the image's build stage: no browser, test framework or container tools)
+#   install-deps.sh --runtime    only what the built programs load (the image's runtime stage)
+#   --list, --list-build, --list-runtime print a list instead of installing it
 set -euo pipefail
 
-packages=(
+build_packages=(
   build-essential cmake ninja-build pkg-config
-  libgtest-dev libgmock-dev
   nlohmann-json3-dev libtinyobjloader-dev libpugixml-dev libstb-dev libspdlog-dev libfmt-dev
   libtbb-dev libcli11-dev libopenexr-dev libimath-dev zlib1g-dev
   libcpp-httplib-dev libsqlite3-dev libssl-dev libzstd-dev libarchive-dev
-  curl bc openssl
+)
+
+# The tests on top of the build: GoogleTest, the tools test scripts call, the dashboard's browser
+# test, and tests/deploy/container_test.sh, which makes a Debian base with debootstrap and builds and
+# runs the image with podman. runc is named so apt does not pick crun for podman (crun fails on some
+# cgroup v1 hosts, docker/podman-env.sh); catatonit is compose's `init: true`, netavark and
+# aardvark-dns the network and service names, iptables its port publishing.
+test_packages=(
+  libgtest-dev libgmock-dev
+  curl bc openssl jq
   python3-yaml iproute2
   chromium chromium-driver python3-selenium
+  podman runc catatonit netavark aardvark-dns iptables buildah debootstrap podman-compose
 )
 
 # What the built programs load at run time: the runtime stage of docker/Dockerfile installs only
@@ -21,11 +35,16 @@ runtime_packages=(
   libspdlog1.10 libfmt9 zlib1g libzstd1 libarchive13 libssl3 libsqlite3-0 libcpp-httplib0.11
   ca-certificates curl
 )
+
+packages=("${build_packages[@]}" "${test_packages[@]}")
 case "${1:-}" in
   "") ;;
+  --build) packages=("${build_packages[@]}") ;;
   --runtime) packages=("${runtime_packages[@]}") ;;
+  --list) printf '%s\n' "${packages[@]}"; exit 0 ;;
+  --list-build) printf '%s\n' "${build_packages[@]}"; exit 0 ;;
   --list-runtime) printf '%s\n' "${runtime_packages[@]}"; exit 0 ;;
-  *) echo "usage: install-deps.sh [--runtime | --list-runtime]" >&2; exit 2 ;;
+  *) echo "usage: install-deps.sh [--build | --runtime | --list | --list-build | --list-runtime]" >&2; exit 2 ;;
 esac
 
 missing=()

@@ -5,7 +5,7 @@
 #include "tessera/farm/bundle.h"
 #include "tessera/farm/job_scene.h"
 #include "tessera/scene/error.h"
-#include "tessera/worker/farm_client.h"
+#include "tessera/client/farm_api.h"
 
 #include <chrono>
 #include <cstdio>
@@ -30,10 +30,10 @@ namespace {
 // The coordinator's client, with the client token from --token-file or $TESSERA_CLIENT_TOKEN;
 // false (the reason printed, prefixed by `who`) if the token file cannot be read.
 bool make_client(const std::string& server, const std::string& token_file, const std::string& ca_file,
-                 const char* who, farm::FarmClient& out) {
+                 const char* who, client::FarmApi& out) {
   try {
-    out = farm::FarmClient(server.empty() ? default_server_url() : server,
-                           resolve_token("", token_file, "TESSERA_CLIENT_TOKEN"), ca_file);
+    out = client::FarmApi(client::FarmClient(server.empty() ? default_server_url() : server,
+                                             resolve_token("", token_file, "TESSERA_CLIENT_TOKEN"), ca_file));
     return true;
   } catch (const std::exception& e) {
     std::cerr << who << ": " << e.what() << "\n";
@@ -47,9 +47,9 @@ std::string extension_of(const std::string& path) {
   return ext.empty() ? ext : ext.substr(1);
 }
 
-bool download_outputs(const farm::FarmClient& client, uint64_t id, const std::vector<std::string>& outputs) {
+bool download_outputs(const client::FarmApi& api, uint64_t id, const std::vector<std::string>& outputs) {
   for (const std::string& out : outputs) {
-    farm::HttpReply r = client.get("/api/v1/jobs/" + std::to_string(id) + "/image?format=" + extension_of(out), 300);
+    client::HttpReply r = api.job_image(id, extension_of(out));
     if (!r.ok()) {
       std::cerr << "tessera submit: cannot download the image: " << r.describe() << "\n";
       return false;
@@ -62,11 +62,11 @@ bool download_outputs(const farm::FarmClient& client, uint64_t id, const std::ve
 }
 
 // Polls until the job ends; returns its final status (null when the server stays unreachable).
-json wait_for(const farm::FarmClient& client, uint64_t id, bool quiet) {
+json wait_for(const client::FarmApi& api, uint64_t id, bool quiet) {
   Progress progress("job " + std::to_string(id), !quiet);
   int failures = 0;
   for (;;) {
-    farm::HttpReply r = client.get("/api/v1/jobs/" + std::to_string(id), 30);
+    client::HttpReply r = api.job(id);
     json j = r.json();
     if (r.ok() && j.is_object()) {
       failures = 0;
@@ -98,8 +98,8 @@ std::string frame_path(const std::string& pattern, int frame) {
 }
 
 // Waits for one job and downloads its outputs; the exit code.
-int finish_job(const farm::FarmClient& client, uint64_t id, const std::vector<std::string>& outputs, bool quiet) {
-  json final_status = wait_for(client, id, quiet);
+int finish_job(const client::FarmApi& api, uint64_t id, const std::vector<std::string>& outputs, bool quiet) {
+  json final_status = wait_for(api, id, quiet);
   if (final_status.is_null()) return 1;
   if (final_status.value("state", "") != "done") {
     std::cerr << "job " << id << " " << final_status.value("state", "") << ": " << final_status.value("error", "")
@@ -111,7 +111,7 @@ int finish_job(const farm::FarmClient& client, uint64_t id, const std::vector<st
     std::cerr << ", stopped at " << final_status.value("spp_done", 0) << " spp (estimated relMSE "
               << final_status.value("noise_estimate", 0.0) << ")";
   std::cerr << "\n";
-  return download_outputs(client, id, outputs) ? 0 : 1;
+  return download_outputs(api, id, outputs) ? 0 : 1;
 }
 
 }  // namespace
@@ -128,10 +128,10 @@ int run_submit(const SubmitOptions& o) {
       return 2;
     }
   }
-  farm::FarmClient client("");
-  if (!make_client(o.server, o.token_file, o.ca_file, "tessera submit", client)) return 2;
+  client::FarmApi api(client::FarmClient(""));
+  if (!make_client(o.server, o.token_file, o.ca_file, "tessera submit", api)) return 2;
   std::string why;
-  if (!client.valid(&why)) {
+  if (!api.valid(&why)) {
     std::cerr << "tessera submit: " << why << "\n";
     return 2;
   }
@@ -162,10 +162,14 @@ int run_submit(const SubmitOptions& o) {
     std::cerr << "error: " << e.what() << "\n";
     return 1;
   }
+  // --wait without -o: the image lands where `tessera render` would put it, SCENE_STEM.exr here.
+  std::vector<std::string> outputs = o.outputs;
+  if (o.wait && outputs.empty())
+    outputs.push_back(fs::path(o.scene).stem().string() + (o.frames.empty() ? ".exr" : "_####.exr"));
   json body = to_json(settings);
   body.erase("scene");
   if (!o.frames.empty()) body["frames"] = o.frames;
-  farm::HttpReply r = client.post_job_with_bundle(body, bundle);
+  client::HttpReply r = api.submit_job(body, bundle);
   json j = r.json();
   if (!r.ok() || !j.is_object()) {
     std::cerr << "tessera submit: the coordinator refused the job: " << r.describe() << "\n";
@@ -173,30 +177,30 @@ int run_submit(const SubmitOptions& o) {
   }
   if (!o.frames.empty()) {
     for (const json& job : j["jobs"]) std::cout << job.value("id", uint64_t(0)) << "\n";
-    std::cerr << j["jobs"].size() << " frame jobs submitted to " << client.url() << "\n";
-    if (!o.wait && o.outputs.empty()) return 0;
+    std::cerr << j["jobs"].size() << " frame jobs submitted to " << api.url() << "\n";
+    if (!o.wait && outputs.empty()) return 0;
     int code = 0;
     for (const json& job : j["jobs"]) {
       const int frame = std::stoi(job["settings"]["defines"].value("frame", "0"));
       std::vector<std::string> outs;
-      for (const auto& out : o.outputs) outs.push_back(frame_path(out, frame));
-      code = std::max(code, finish_job(client, job.value("id", uint64_t(0)), outs, o.quiet));
+      for (const auto& out : outputs) outs.push_back(frame_path(out, frame));
+      code = std::max(code, finish_job(api, job.value("id", uint64_t(0)), outs, o.quiet));
     }
     return code;
   }
   const uint64_t id = j.value("id", uint64_t(0));
   std::cout << id << "\n";
-  std::cerr << "job " << id << " submitted to " << client.url() << ": " << j.value("width", 0) << "x"
+  std::cerr << "job " << id << " submitted to " << api.url() << ": " << j.value("width", 0) << "x"
             << j.value("height", 0) << ", " << j.value("spp", 0) << " spp, " << j.value("tiles", 0) << " tiles x "
             << j.value("passes", 0) << " passes\n";
-  if (!o.wait && o.outputs.empty()) return 0;
-  return finish_job(client, id, o.outputs, o.quiet);
+  if (!o.wait && outputs.empty()) return 0;
+  return finish_job(api, id, outputs, o.quiet);
 }
 
 int run_jobs(const JobsOptions& o) {
-  farm::FarmClient client("");
-  if (!make_client(o.server, o.token_file, o.ca_file, "tessera jobs", client)) return 2;
-  farm::HttpReply r = client.get("/api/v1/jobs");
+  client::FarmApi api(client::FarmClient(""));
+  if (!make_client(o.server, o.token_file, o.ca_file, "tessera jobs", api)) return 2;
+  client::HttpReply r = api.jobs();
   json j = r.json();
   if (!r.ok() || !j.is_object()) {
     std::cerr << "tessera jobs: " << r.describe() << "\n";
@@ -212,9 +216,9 @@ int run_jobs(const JobsOptions& o) {
 }
 
 int run_cancel(const JobsOptions& o) {
-  farm::FarmClient client("");
-  if (!make_client(o.server, o.token_file, o.ca_file, "tessera cancel", client)) return 2;
-  farm::HttpReply r = client.del("/api/v1/jobs/" + std::to_string(o.cancel_id));
+  client::FarmApi api(client::FarmClient(""));
+  if (!make_client(o.server, o.token_file, o.ca_file, "tessera cancel", api)) return 2;
+  client::HttpReply r = api.cancel_job(o.cancel_id);
   if (!r.ok()) {
     std::cerr << "tessera cancel: " << r.describe() << "\n";
     return 1;

@@ -4,6 +4,8 @@
 
 #include <openssl/crypto.h>
 
+#include <cctype>
+
 
 namespace tessera::server {
 
@@ -31,10 +33,19 @@ bool tokens_equal(const std::string& a, const std::string& b) {
   return CRYPTO_memcmp(da.data(), db.data(), da.size()) == 0;
 }
 
+std::string bearer_token(const std::string& authorization) {
+  // RFC 7235: the scheme is case-insensitive and followed by one or more spaces.
+  const std::string scheme = "bearer";
+  if (authorization.size() <= scheme.size() || authorization[scheme.size()] != ' ') return "";
+  for (size_t i = 0; i < scheme.size(); ++i)
+    if (std::tolower(static_cast<unsigned char>(authorization[i])) != scheme[i]) return "";
+  const size_t start = authorization.find_first_not_of(' ', scheme.size());
+  return start == std::string::npos ? "" : authorization.substr(start);
+}
+
 bool authorized(const AuthTokens& tokens, Access access, const std::string& authorization) {
   if (access == Access::Open) return true;
-  const std::string prefix = "Bearer ";
-  const std::string given = authorization.rfind(prefix, 0) == 0 ? authorization.substr(prefix.size()) : "";
+  const std::string given = bearer_token(authorization);
   auto accepts = [&](const std::string& token) { return token.empty() || (!given.empty() && tokens_equal(given, token)); };
   switch (access) {
     case Access::Client: return accepts(tokens.client);

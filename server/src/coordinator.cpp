@@ -81,20 +81,23 @@ Coordinator::Coordinator(CoordinatorOptions options) : impl_(std::make_unique<Im
     }
     auto job = s.rebuild_job(row);
     passes += job->done_units();
-    const bool completed_now = !is_terminal(job->phase) && job->complete();  // its last result landed before a crash
-    if (completed_now) {
-      job->phase = JobPhase::Done;
-      job->finished = wall_seconds();
-    }
-    if (!is_terminal(job->phase)) ++resumed;
-    else try {
-      s.save_phase(*job, /*notify=*/completed_now);  // (else it ended before its image was written)
+    try {
+      if (!is_terminal(job->phase) && job->complete()) {  // its last result landed before a crash
+        s.change_phase(*job, JobPhase::Done);
+      } else if (is_terminal(job->phase)) {
+        s.save_phase(*job, /*notify=*/false);  // it ended before its image was written
+      } else {
+        ++resumed;
+        s.hold_open_leases(*job);
+      }
     } catch (const StoreError& e) {  // a full disk: the image is retried by the retention pass
       if (!e.disk_full) throw;
       spdlog::warn("job {}: {}", row.id, e.what());
     }
     s.jobs.emplace(row.id, std::move(job));
   }
+  // /metrics counts from what the data dir holds, so "done" never exceeds "leased" after a restart.
+  std::tie(s.counters.leased, s.counters.done) = s.store.lease_and_result_counts();
   if (!s.jobs.empty())
     spdlog::info("coordinator: {} jobs in {}, {} resumed with {} acknowledged passes", s.jobs.size(), s.opt.data_dir,
                  resumed, passes);
@@ -110,6 +113,18 @@ void Coordinator::shutdown() {
   std::lock_guard<std::mutex> lock(impl_->mu);
   impl_->stopping = true;
   impl_->work_cv.notify_all();
+}
+
+void Coordinator::Impl::hold_open_leases(JobState& job) {
+  // Their workers may still be rendering them: a heartbeat naming the lease re-adopts it, and only
+  // a unit nobody claims within dead_after() is leased again (never rendered twice for a restart).
+  for (const LeaseRow& l : store.open_leases(job.id())) {
+    if (l.tile >= job.num_tiles() || l.pass >= job.num_passes()) continue;
+    const size_t unit = job.unit(l.tile, l.pass);
+    if (job.is_done(unit)) continue;
+    job.lease_started(unit);
+    leases[l.id] = LeaseInfo{l.id, job.id(), l.worker, unit, Clock::now() + dead_after()};
+  }
 }
 
 void Coordinator::Impl::end_lease(std::map<uint64_t, LeaseInfo>::iterator it) {
@@ -151,11 +166,15 @@ std::string Coordinator::Impl::image_path(uint64_t job) const {
 
 void Coordinator::Impl::save_phase(JobState& job, bool notify) {
   store.set_job_state(job.id(), phase_name(job.phase), job.error, job.started, job.finished);
+  finish_job(job, notify);
+}
+
+void Coordinator::Impl::finish_job(JobState& job, bool notify) {
   if (is_terminal(job.phase) && job.has_film()) {
     const std::string path = image_path(job.id());
     write_image_durably(path, job.image(),
                 {{"tessera_version", TESSERA_VERSION}, {"tessera_job", std::to_string(job.id())},
-                 {"tessera_spp", std::to_string(job.converged() ? job.spp_complete() : uint32_t(job.plan().settings.spp))},
+                 {"tessera_spp", std::to_string(image_spp(job))},
                  {"tessera_seed", std::to_string(job.plan().settings.seed)}}, opt.data_dir);
     job.release_film();
   }
@@ -178,24 +197,23 @@ void Coordinator::Impl::reap_loop() {
       lock.lock();
       next_retention = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(opt.maintenance_interval));
     }
-    const auto now = Clock::now();
-    for (auto it = leases.begin(); it != leases.end();) {
-      auto next = std::next(it);
-      if (it->second.expires < now) {
-        log_event(spdlog::level::warn, "lease.expired",
-                  {{"lease", it->first}, {"job", it->second.job}, {"unit", it->second.unit}, {"worker", it->second.worker}});
-        ++counters.expired;
-        end_lease(it);
-      }
-      it = next;
-    }
-    const auto silent = std::chrono::duration<double>(opt.lease_timeout);
-    for (auto& [id, w] : workers)
-      if ((w.state == "idle" || w.state == "busy") && now - w.last_seen > silent) {
-        w.state = "lost";
-        log_event(spdlog::level::warn, "worker.lost", {{"worker", id}, {"name", w.row.name}});
-      }
+    reap_leases_and_workers();
   }
+}
+
+void Coordinator::Impl::reap_leases_and_workers() {
+  const auto now = Clock::now();
+  for (auto& [id, w] : workers)
+    if (is_live(w.state) && now - w.last_seen > dead_after()) {
+      for (auto& [lid, l] : leases) counters.expired += l.worker == id;
+      set_worker_state(id, w, WorkerState::Lost);
+    }
+  end_leases_if([&](const LeaseInfo& l) {
+    if (l.expires >= now) return false;
+    log_event(spdlog::level::warn, "lease.expired", {{"lease", l.id}, {"job", l.job}, {"unit", l.unit}, {"worker", l.worker}});
+    ++counters.expired;
+    return true;
+  });
 }
 
 std::string Coordinator::metrics() {
@@ -208,17 +226,20 @@ std::string Coordinator::metrics() {
   for (auto& [id, job] : s.jobs) ++jobs[phase_name(job->phase)];
   for (auto& [state, n] : jobs) out += "tessera_jobs{state=\"" + state + "\"} " + std::to_string(n) + "\n";
 
-  out += metric_header("tessera_passes_total", "counter", "Tile passes leased, done, expired, failed, duplicated since start.");
+  out += metric_header("tessera_passes_total", "counter",
+                       "Tile passes leased, done, expired, failed, duplicated, speculatively leased, mismatched.");
   const auto& c = s.counters;
   for (auto [event, n] : {std::pair{"leased", c.leased}, std::pair{"done", c.done}, std::pair{"expired", c.expired},
-                          std::pair{"failed", c.failed}, std::pair{"duplicate", c.duplicates}})
+                          std::pair{"failed", c.failed}, std::pair{"duplicate", c.duplicates},
+                          std::pair{"speculative", c.speculative}, std::pair{"mismatched", c.mismatched}})
     out += std::string("tessera_passes_total{event=\"") + event + "\"} " + std::to_string(n) + "\n";
   out += metric_header("tessera_leases_active", "gauge", "Leases in flight.");
   out += "tessera_leases_active " + std::to_string(s.leases.size()) + "\n";
 
   out += metric_header("tessera_workers", "gauge", "Workers by state.");
-  std::map<std::string, int> workers = {{"idle", 0}, {"busy", 0}, {"draining", 0}, {"lost", 0}, {"gone", 0}};
-  for (auto& [id, w] : s.workers) ++workers[w.state];
+  std::map<std::string, int> workers;
+  for (WorkerState state : kWorkerStates) workers[worker_state_name(state)] = 0;
+  for (auto& [id, w] : s.workers) ++workers[worker_state_name(w.state)];
   for (auto& [state, n] : workers) out += "tessera_workers{state=\"" + state + "\"} " + std::to_string(n) + "\n";
   out += metric_header("tessera_worker_samples_per_second", "gauge", "Pixel samples per second of render time, per worker.");
   for (auto& [id, w] : s.workers)

@@ -3,6 +3,7 @@
 #include "coordinator_impl.h"
 #include "disk_full.h"
 #include "event_log.h"
+#include "scene_planner.h"
 
 #include "tessera/farm/sha256.h"
 #include "tessera/image/image.h"
@@ -65,17 +66,7 @@ std::string read_file(const std::string& path) {
   return ss.str();
 }
 
-// Loader messages name files by their path in the data directory; users know them by their path
-// in the bundle.
-std::string strip_dir(std::string msg, const std::string& dir) {
-  for (const std::string& prefix : {fs::weakly_canonical(dir).string() + "/", dir + "/"})
-    for (size_t at; (at = msg.find(prefix)) != std::string::npos;) msg.erase(at, prefix.size());
-  for (const std::string& root : {fs::weakly_canonical(dir).string(), dir})  // the folder itself
-    for (size_t at; (at = msg.find(root)) != std::string::npos;) msg.replace(at, root.size(), "<bundle>");
-  return msg;
-}
 
-std::mutex unpack_mutex;  // one unpack per bundle at a time
 
 
 }  // namespace
@@ -96,7 +87,7 @@ Result<json> Coordinator::upload_scene(const std::string& bundle) {
   if (bundle.size() > s.opt.max_upload_bytes)
     return make_error(Code::PayloadTooLarge, "bundle_too_large",
                       "the bundle has " + std::to_string(bundle.size()) + " bytes; the limit is " +
-                          std::to_string(s.opt.max_upload_bytes));
+                          std::to_string(s.opt.max_upload_bytes) + " (tessera-server --max-upload)");
   BundleResult inspected = inspect_bundle(bundle, s.opt.bundle_limits);
   if (!inspected.ok()) return make_error(Code::BadRequest, "bad_bundle", inspected.error);
   const std::string hash = sha256_hex(bundle);
@@ -206,6 +197,39 @@ Result<json> Coordinator::submit_frames(const json& body, const std::string& bun
   return json{{"jobs", jobs}, {"frames", {first, last}}};
 }
 
+// Unpacked once per bundle (later submissions list the folder); two bundles unpack in parallel.
+Result<std::string> Coordinator::Impl::unpack_scene(const JobSettings& settings, const std::string& bundle_file) {
+  const std::string dir = scene_dir(settings.scene);
+  std::shared_ptr<std::mutex> bundle_mutex;
+  {
+    std::lock_guard<std::mutex> lock(unpack_mutexes_mu);
+    if (unpack_mutexes.size() > 64)  // forget bundles nobody is unpacking
+      std::erase_if(unpack_mutexes, [](const auto& entry) { return entry.second.expired(); });
+    std::weak_ptr<std::mutex>& slot = unpack_mutexes[settings.scene];
+    bundle_mutex = slot.lock();
+    if (!bundle_mutex) slot = bundle_mutex = std::make_shared<std::mutex>();
+  }
+  std::vector<BundleEntry> entries;
+  std::string error;
+  try {
+    std::lock_guard<std::mutex> lock(*bundle_mutex);
+    if (fs::exists(dir)) {
+      for (const auto& e : fs::recursive_directory_iterator(dir))
+        if (e.is_regular_file()) entries.push_back({e.path().lexically_relative(dir).generic_string(), e.file_size()});
+    } else {
+      BundleResult unpacked = unpack_bundle(read_file(bundle_file), dir, opt.bundle_limits);
+      throw_if_disk_full(unpacked.error, opt.data_dir);
+      if (!unpacked.ok()) return make_error(Code::BadRequest, "bad_bundle", unpacked.error);
+      entries = std::move(unpacked.files);
+    }
+  } catch (const std::exception& e) {
+    return internal_error(e);
+  }
+  std::string scene_file = find_scene_xml(entries, settings.scene_file, error);
+  if (scene_file.empty()) return make_error(Code::Unprocessable, "no_scene_file", error);
+  return scene_file;
+}
+
 Result<json> Coordinator::submit_job(const json& body, const std::string& bundle) {
   Impl& s = *impl_;
   if (body.is_object() && body.contains("frames")) return submit_frames(body, bundle);
@@ -230,53 +254,33 @@ Result<json> Coordinator::submit_job(const json& body, const std::string& bundle
   if (!check_job_limits(settings, s.opt.limits, error)) return make_error(Code::Unprocessable, "bad_settings", error);
   Result<std::string> path = scene_bundle_path(settings.scene);
   if (!path.ok()) return path.status;
+  Result<std::string> scene_file = s.unpack_scene(settings, path.value);
+  if (!scene_file.ok()) return scene_file.status;
+  const PlanRequest request{s.scene_dir(settings.scene), scene_file.value, settings};
+  Result<JobPlan> plan = s.opt.scene_planner.empty() ? plan_scene_here(request)
+                                                      : plan_scene_in_child(s.opt.scene_planner, request);
+  if (!plan.ok()) return plan.status;
+  if (!check_job_limits(plan.value.settings, s.opt.limits, error))
+    return make_error(Code::Unprocessable, "bad_settings", error);
+  return s.add_job(settings.name, std::move(plan.value));
+}
 
-  const std::string dir = s.scene_dir(settings.scene);
-  JobPlan plan;
-  try {
-    std::vector<BundleEntry> entries;
-    {
-      std::lock_guard<std::mutex> lock(unpack_mutex);
-      if (fs::exists(dir)) {
-        // Unpacked (and checked) by an earlier submission: list it instead of reading the bundle again.
-        for (const auto& e : fs::recursive_directory_iterator(dir))
-          if (e.is_regular_file()) entries.push_back({e.path().lexically_relative(dir).generic_string(), e.file_size()});
-      } else {
-        BundleResult unpacked = unpack_bundle(read_file(path.value), dir, s.opt.bundle_limits);
-        throw_if_disk_full(unpacked.error, s.opt.data_dir);
-        if (!unpacked.ok()) return make_error(Code::BadRequest, "bad_bundle", unpacked.error);
-        entries = std::move(unpacked.files);
-      }
-    }
-    std::string scene_file = find_scene_xml(entries, settings.scene_file, error);
-    if (scene_file.empty()) return make_error(Code::Unprocessable, "no_scene_file", error);
-    LoadedJobScene loaded = load_job_scene(dir, scene_file, settings);
-    plan = make_job_plan(dir, scene_file, settings, loaded);
-  } catch (const UnsupportedError& e) {
-    return make_error(Code::Unprocessable, "scene_unsupported", strip_dir(e.what(), dir));
-  } catch (const SceneError& e) {
-    return make_error(Code::Unprocessable, "scene_load_failed", strip_dir(e.what(), dir));
-  } catch (const DiskFullError& e) {
-    return internal_error(e);
-  } catch (const std::exception& e) {
-    return make_error(Code::Unprocessable, "scene_load_failed", strip_dir(e.what(), dir));
-  }
-  if (!check_job_limits(plan.settings, s.opt.limits, error)) return make_error(Code::Unprocessable, "bad_settings", error);
-
-  std::lock_guard<std::mutex> lock(s.mu);
-  if (s.stopping) return make_error(Code::Unavailable, "stopping", "the coordinator is shutting down");
-  if (Status st = s.check_active_jobs(); !st.ok()) return st;
+Result<json> Coordinator::Impl::add_job(const std::string& name, JobPlan plan) {
+  std::lock_guard<std::mutex> lock(mu);
+  if (stopping) return make_error(Code::Unavailable, "stopping", "the coordinator is shutting down");
+  if (Status st = check_active_jobs(); !st.ok()) return st;
   try {
     const double now = wall_seconds();
-    uint64_t id = s.store.add_job(settings.name, to_json(plan).dump(), settings.priority, now);
-    auto job = std::make_unique<JobState>(id, std::move(plan), settings.name, settings.priority, now);
+    const int priority = plan.settings.priority;
+    uint64_t id = store.add_job(name, to_json(plan).dump(), priority, now);
+    auto job = std::make_unique<JobState>(id, std::move(plan), name, priority, now);
     log_event(spdlog::level::info, "job.submitted",
-              {{"job", id}, {"name", settings.name}, {"width", job->plan().window.width()},
+              {{"job", id}, {"name", name}, {"width", job->plan().window.width()},
                {"height", job->plan().window.height()}, {"spp", job->plan().settings.spp}, {"tiles", job->num_tiles()},
-               {"passes", job->num_passes()}, {"scene", settings.scene}});
-    json status = s.status_json(*job);
-    s.jobs.emplace(id, std::move(job));
-    s.work_cv.notify_all();
+               {"passes", job->num_passes()}, {"scene", job->plan().settings.scene}});
+    json status = status_json(*job);
+    jobs.emplace(id, std::move(job));
+    work_cv.notify_all();
     return status;
   } catch (const std::exception& e) {
     return internal_error(e);
@@ -319,6 +323,7 @@ json Coordinator::Impl::status_json(const JobState& job) {
             {"created", job.created()},
             {"workers", workers_json},
             {"duplicate_results", job.duplicates},
+            {"mismatched_results", job.mismatched},
             {"result_bytes", job.result_bytes},
             {"lease_bytes", job.lease_bytes},
             {"nonfinite_samples", job.counters().nonfinite}};
@@ -370,11 +375,13 @@ Result<ImageBytes> Coordinator::job_image(uint64_t id, const std::string& format
     return make_error(Code::BadRequest, "bad_format", "format '" + format + "' is not exr, png or pfm");
   Image image;
   JobPlan plan;
+  uint32_t spp = 0;
   {
     std::lock_guard<std::mutex> lock(s.mu);
     auto it = s.jobs.find(id);
     if (it == s.jobs.end()) return s.missing_job(id);
     plan = it->second->plan();
+    spp = image_spp(*it->second);
     if (it->second->has_film()) image = it->second->image();
   }
   if (image.width() == 0) {  // an ended job: its image is on disk
@@ -400,7 +407,7 @@ Result<ImageBytes> Coordinator::job_image(uint64_t id, const std::string& format
       write_image(tmp, image,
                   {{"tessera_version", TESSERA_VERSION},
                    {"tessera_job", std::to_string(id)},
-                   {"tessera_spp", std::to_string(plan.settings.spp)},
+                   {"tessera_spp", std::to_string(spp)},
                    {"tessera_seed", std::to_string(plan.settings.seed)}});
     }
     verify_image_file(tmp, format, image, s.opt.data_dir);  // (a full disk can truncate it silently)
@@ -424,15 +431,11 @@ Status Coordinator::cancel_job(uint64_t id) {
   JobState& job = *it->second;
   if (is_terminal(job.phase))
     return make_error(Code::Conflict, "job_finished", "job " + std::to_string(id) + " is already " + phase_name(job.phase));
-  job.phase = JobPhase::Cancelled;
-  job.finished = wall_seconds();
-  s.end_leases_if([&](const LeaseInfo& l) { return l.job == id; });
   try {
-    s.save_phase(job);
+    s.change_phase(job, JobPhase::Cancelled);
   } catch (const std::exception& e) {
     return internal_error(e);
   }
-  log_event(spdlog::level::info, "job.cancelled", {{"job", id}});
   return Status::success();
 }
 
@@ -441,6 +444,9 @@ Status Coordinator::set_priority(uint64_t id, int priority) {
   std::lock_guard<std::mutex> lock(s.mu);
   auto it = s.jobs.find(id);
   if (it == s.jobs.end()) return unknown_job(id);
+  if (is_terminal(it->second->phase))
+    return make_error(Code::Conflict, "job_finished",
+                      "job " + std::to_string(id) + " is " + phase_name(it->second->phase) + "; retry it first");
   try {
     s.store.set_job_priority(id, priority);
   } catch (const std::exception& e) {
@@ -463,15 +469,14 @@ Status Coordinator::retry_job(uint64_t id) {
                       "job " + std::to_string(id) + " is " + phase_name(old.phase) + "; only failed or cancelled jobs are retried");
   try {
     // The passes it has stay: the job is rebuilt from its stored results, film included.
-    JobRow row{id, old.name(), to_json(old.plan()).dump(), "queued", "", old.priority(), old.created(), old.started, 0};
+    JobRow row{id, old.name(), to_json(old.plan()).dump(), phase_name(old.phase), old.error, old.priority(),
+               old.created(), old.started, old.finished};
     auto job = s.rebuild_job(row);
-    s.save_phase(*job);
-    log_event(spdlog::level::info, "job.retried", {{"job", id}, {"units_done", job->done_units()}, {"units", job->num_units()}});
+    s.change_phase(*job, JobPhase::Queued);
     it->second = std::move(job);
   } catch (const std::exception& e) {
     return internal_error(e);
   }
-  s.work_cv.notify_all();
   return Status::success();
 }
 

@@ -3,7 +3,10 @@
 #include "coordinator_impl.h"
 #include "event_log.h"
 
+#include "tessera/farm/sha256.h"
 #include "tessera/farm/tile_result.h"
+
+#include <limits>
 
 #include <spdlog/spdlog.h>
 
@@ -16,6 +19,31 @@ Status unknown_worker(uint64_t id) {
   return make_error(Code::NotFound, "unknown_worker", "no worker " + std::to_string(id) + "; register again");
 }
 }  // namespace
+
+void Coordinator::Impl::set_worker_state(uint64_t id, WorkerInfo& w, WorkerState to) {
+  if (w.state == to || w.state == WorkerState::Gone) return;  // (signing off is final)
+  const WorkerState from = w.state;
+  w.state = to;
+  if (to == WorkerState::Lost) {
+    log_event(spdlog::level::warn, "worker.lost", {{"worker", id}, {"name", w.row.name}});
+    // Dead: what it held is re-issued now rather than after each lease's own expiry.
+    end_leases_if([&](const LeaseInfo& l) { return l.worker == id; });
+  } else if (from == WorkerState::Lost) {
+    log_event(spdlog::level::info, "worker.back", {{"worker", id}, {"name", w.row.name}});
+  }
+}
+
+void Coordinator::Impl::saw_worker(uint64_t id, WorkerInfo& w) {
+  w.last_seen = Clock::now();
+  if (w.state == WorkerState::Lost) update_busy(id, w);
+}
+
+void Coordinator::Impl::update_busy(uint64_t id, WorkerInfo& w) {
+  if (w.state == WorkerState::Draining || w.state == WorkerState::Gone) return;
+  bool holds = false;
+  for (auto& [lid, l] : leases) holds |= l.worker == id;
+  set_worker_state(id, w, holds ? WorkerState::Busy : WorkerState::Idle);
+}
 
 WorkerInfo* Coordinator::Impl::find_worker(uint64_t id) {
   auto it = workers.find(id);
@@ -50,12 +78,71 @@ Result<json> Coordinator::register_worker(const json& body) {
     log_event(spdlog::level::info, "worker.registered",
               {{"worker", row.id}, {"name", hello.name}, {"threads", hello.threads}, {"isa", hello.isa}});
     return json{{"id", row.id},
-                {"lease_timeout", s.opt.lease_timeout},
-                {"heartbeat_seconds", s.opt.lease_timeout / 4},
+                {"lease_timeout", s.opt.heartbeat_interval * kMissedHeartbeats},
+                {"heartbeat_seconds", s.opt.heartbeat_interval},
                 {"max_poll_wait", s.opt.max_poll_wait}};
   } catch (const std::exception& e) {
     return internal_error(e);
   }
+}
+
+std::optional<UnitChoice> Coordinator::Impl::choose_unit_for(uint64_t worker) {
+  auto excluded = [&](const JobState& job) {
+    auto f = job.failures_by_worker.find(worker);
+    return f != job.failures_by_worker.end() && f->second >= opt.worker_failure_limit;
+  };
+  std::vector<JobCandidate> candidates;
+  int top = std::numeric_limits<int>::min();
+  for (auto& [id, job] : jobs) {
+    if (is_terminal(job->phase)) continue;
+    candidates.push_back({id, job->priority(), job->next_unit(), excluded(*job)});
+    top = std::max(top, job->priority());
+  }
+  std::vector<LeaseCandidate> outstanding;
+  // Leases are listed only when a job outranks the fresh choice (rare: a job's last units).
+  if (opt.speculate && speculation_floor(candidates) < top) {
+    for (auto& [id, l] : leases) {
+      auto job = jobs.find(l.job);
+      if (job == jobs.end() || is_terminal(job->second->phase)) continue;
+      outstanding.push_back({l.job, job->second->priority(), l.unit, l.worker,
+                             job->second->active_leases(l.unit), excluded(*job->second)});
+    }
+  }
+  return choose_unit(candidates, outstanding, worker, opt.speculate);
+}
+
+Result<json> Coordinator::Impl::issue_lease(uint64_t worker, WorkerInfo& w, const UnitChoice& choice) {
+  JobState& job = *jobs.at(choice.job);
+  const size_t unit = choice.unit;
+  const double now = wall_seconds();
+  // The job's first lease: persisted before anything is recorded in memory, so a failed write
+  // (a full disk) leaves no lease behind that would hold the unit until it expires.
+  if (job.phase == JobPhase::Queued) change_phase(job, JobPhase::Running);
+  Lease l;
+  l.id = store.log_lease(job.id(), job.tile_of(unit), job.pass_of(unit), worker, now);
+  l.job_id = job.id();
+  l.tile = job.tile_of(unit);
+  l.pass = job.pass_of(unit);
+  l.rect = job.rect(unit);
+  l.sample_begin = job.sample_begin(unit);
+  l.sample_end = job.sample_end(unit);
+  l.seconds_to_expiry = opt.heartbeat_interval * kMissedHeartbeats;
+  l.settings = job.plan().settings;
+  l.scene_file = job.plan().scene_file;
+  l.files = job.plan().files;
+  job.lease_started(unit);
+  leases[l.id] = LeaseInfo{l.id, l.job_id, worker, unit, Clock::now() + dead_after()};
+  set_worker_state(worker, w, WorkerState::Busy);
+  json j = to_json(l);
+  const size_t bytes = j.dump().size();
+  job.lease_bytes += bytes;
+  counters.bytes_out += bytes;
+  ++counters.leased;
+  if (choice.speculative) ++counters.speculative;
+  log_event(spdlog::level::debug, "lease.issued",
+            {{"lease", l.id}, {"job", l.job_id}, {"tile", l.tile}, {"pass", l.pass}, {"worker", worker},
+             {"speculative", choice.speculative}});
+  return j;
 }
 
 Result<json> Coordinator::lease(uint64_t worker, double wait_seconds) {
@@ -72,140 +159,69 @@ Result<json> Coordinator::lease(uint64_t worker, double wait_seconds) {
   std::unique_lock<std::mutex> lock(s.mu);
   WorkerInfo* w = s.find_worker(worker);
   if (!w) return unknown_worker(worker);
-  w->last_seen = Clock::now();
-  if (w->state == "draining")
-    return make_error(Code::Gone, "drained", "worker " + std::to_string(worker) + " is being drained: no more work");
+  s.saw_worker(worker, *w);
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
                                            std::clamp(wait_seconds, 0.0, s.opt.max_poll_wait)));
   for (;;) {
     if (s.stopping) return make_error(Code::Unavailable, "stopping", "the coordinator is shutting down");
-    if (w->state == "draining")
+    if (w->state == WorkerState::Draining)
       return make_error(Code::Gone, "drained", "worker " + std::to_string(worker) + " is being drained: no more work");
-    JobState* best = nullptr;
-    size_t unit = 0;
-    for (auto& [id, job] : s.jobs) {
-      if (is_terminal(job->phase)) continue;
-      if (best && (job->priority() < best->priority())) continue;
-      if (best && job->priority() == best->priority()) continue;  // same priority: earlier job first
-      auto f = job->failures_by_worker.find(worker);
-      if (f != job->failures_by_worker.end() && f->second >= s.opt.worker_failure_limit) continue;
-      if (std::optional<size_t> u = job->next_unit()) {
-        best = job.get();
-        unit = *u;
-      }
-    }
-    if (best) {
+    if (std::optional<UnitChoice> choice = s.choose_unit_for(worker)) {
+      Result<json> issued = make_error(Code::Internal, "internal", "no lease");
       try {
-        const double now = wall_seconds();
-        // The job's first lease: persisted before anything is recorded in memory, so a failed write
-        // (a full disk) leaves no lease behind that would hold the unit until it expires.
-        if (best->phase == JobPhase::Queued) {
-          best->phase = JobPhase::Running;
-          best->started = now;
-          try {
-            s.save_phase(*best);
-          } catch (...) {
-            best->phase = JobPhase::Queued;
-            best->started = 0;
-            throw;
-          }
-          log_event(spdlog::level::info, "job.started", {{"job", best->id()}});
-        }
-        Lease l;
-        l.id = s.store.log_lease(best->id(), best->tile_of(unit), best->pass_of(unit), worker, now);
-        l.job_id = best->id();
-        l.tile = best->tile_of(unit);
-        l.pass = best->pass_of(unit);
-        l.rect = best->rect(unit);
-        l.sample_begin = best->sample_begin(unit);
-        l.sample_end = best->sample_end(unit);
-        l.seconds_to_expiry = s.opt.lease_timeout;
-        l.settings = best->plan().settings;
-        l.scene_file = best->plan().scene_file;
-        l.files = best->plan().files;
-        best->lease_started(unit);
-        s.leases[l.id] = LeaseInfo{l.id, l.job_id, worker, unit,
-                                   Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                                      std::chrono::duration<double>(s.opt.lease_timeout))};
-        w->state = "busy";
-        json j = to_json(l);
-        const size_t bytes = j.dump().size();
-        best->lease_bytes += bytes;
-        s.counters.bytes_out += bytes;
-        ++s.counters.leased;
-        log_event(spdlog::level::debug, "lease.issued",
-                  {{"lease", l.id}, {"job", l.job_id}, {"tile", l.tile}, {"pass", l.pass}, {"worker", worker}});
-        s.lease_wait.observe(std::chrono::duration<double>(Clock::now() - t0).count());
-        return j;
+        issued = s.issue_lease(worker, *w, *choice);
       } catch (const std::exception& e) {
         return internal_error(e);
       }
+      s.lease_wait.observe(std::chrono::duration<double>(Clock::now() - t0).count());
+      return issued;
     }
     if (Clock::now() >= deadline) break;
-    if (w->state == "busy") {  // waiting for work with none in hand: idle, as the dashboard shows
-      bool holds = false;
-      for (auto& [id, l] : s.leases) holds |= l.worker == worker;
-      if (!holds) w->state = "idle";
-    }
+    s.update_busy(worker, *w);  // waiting for work with none in hand: idle, as the dashboard shows
     s.work_cv.wait_until(lock, deadline);
+    s.saw_worker(worker, *w);  // (a long poll is a sign of life too)
   }
-  if (w->state == "busy") {  // (a draining worker keeps its state)
-    bool holds = false;
-    for (auto& [id, l] : s.leases) holds |= l.worker == worker;
-    if (!holds) w->state = "idle";
-  }
+  s.update_busy(worker, *w);
   s.lease_wait.observe(std::chrono::duration<double>(Clock::now() - t0).count());
   return json();
 }
 
-Result<json> Coordinator::heartbeat(uint64_t worker, const json& body) {
+Result<json> Coordinator::heartbeat(uint64_t worker, const std::vector<HeldLease>& held) {
   Impl& s = *impl_;
   std::lock_guard<std::mutex> lock(s.mu);
   WorkerInfo* w = s.find_worker(worker);
   if (!w) return unknown_worker(worker);
-  w->last_seen = Clock::now();
-  if (w->state == "lost") w->state = "busy";
+  s.saw_worker(worker, *w);
   json drop = json::array();
-  auto leases = body.is_object() ? body.find("leases") : body.end();
-  if (body.is_object() && leases != body.end() && leases->is_array()) {
-    for (const json& item : *leases) {
-      auto number = [&item](const char* key) {
-        auto it = item.find(key);
-        return it != item.end() && it->is_number_unsigned();
-      };
-      if (!item.is_object() || !number("id") || !number("job") || !number("tile") || !number("pass"))
-        return make_error(Code::BadRequest, "bad_heartbeat",
-                          "each lease in 'leases' must be {\"id\", \"job\", \"tile\", \"pass\"} with unsigned integers");
-      const uint64_t id = item["id"].get<uint64_t>();
-      auto it = s.leases.find(id);
-      if (it != s.leases.end() && it->second.worker == worker) {
-        auto job = s.jobs.find(it->second.job);
-        if (job != s.jobs.end() && job->second->is_done(it->second.unit)) {
-          drop.push_back(id);  // someone else delivered it first
-          s.end_lease(it);
-          continue;
-        }
-        it->second.expires = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                                std::chrono::duration<double>(s.opt.lease_timeout));
-        continue;
-      }
-      // Unknown (a lease from before a coordinator restart): keep it if its work is still wanted.
-      const uint64_t job_id = item["job"].get<uint64_t>();
-      const uint64_t tile = item["tile"].get<uint64_t>(), pass = item["pass"].get<uint64_t>();
-      auto job = s.jobs.find(job_id);
-      if (job == s.jobs.end() || is_terminal(job->second->phase) || tile >= job->second->num_tiles() ||
-          pass >= job->second->num_passes() || job->second->is_done(job->second->unit(tile, pass))) {
-        drop.push_back(id);
-        continue;
-      }
-      size_t unit = job->second->unit(uint32_t(tile), uint32_t(pass));
-      job->second->lease_started(unit);
-      s.leases[id] = LeaseInfo{id, job_id, worker, unit,
-                               Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                                  std::chrono::duration<double>(s.opt.lease_timeout))};
-    }
-  }
+  for (const HeldLease& l : held)
+    if (!s.keep_lease(worker, l)) drop.push_back(l.id);
+  s.update_busy(worker, *w);
   return json{{"drop", drop}};
+}
+
+bool Coordinator::Impl::keep_lease(uint64_t worker, const HeldLease& held) {
+  auto it = leases.find(held.id);
+  if (it != leases.end() && it->second.worker == worker) {
+    auto job = jobs.find(it->second.job);
+    if (job != jobs.end() && job->second->is_done(it->second.unit)) {
+      end_lease(it);  // someone else delivered it first
+      return false;
+    }
+    it->second.expires = Clock::now() + dead_after();
+    return true;
+  }
+  // Unknown (ended while its worker was thought dead, or logged by a process before a restart
+  // that did not hold it): kept if its work is still wanted.
+  auto job = jobs.find(held.job);
+  if (job == jobs.end() || is_terminal(job->second->phase) || held.tile >= job->second->num_tiles() ||
+      held.pass >= job->second->num_passes())
+    return false;
+  const size_t unit = job->second->unit(held.tile, held.pass);
+  if (job->second->is_done(unit)) return false;
+  if (it != leases.end()) end_lease(it);  // (an id another worker holds: never two owners)
+  job->second->lease_started(unit);
+  leases[held.id] = LeaseInfo{held.id, held.job, worker, unit, Clock::now() + dead_after()};
+  return true;
 }
 
 Result<json> Coordinator::upload_result(uint64_t worker, uint64_t lease, std::string_view bytes) {
@@ -218,7 +234,7 @@ Result<json> Coordinator::upload_result(uint64_t worker, uint64_t lease, std::st
   std::lock_guard<std::mutex> lock(s.mu);
   WorkerInfo* w = s.find_worker(worker);
   if (!w) return unknown_worker(worker);
-  w->last_seen = Clock::now();
+  s.saw_worker(worker, *w);
   auto it = s.jobs.find(result.job_id);
   if (it == s.jobs.end()) return unknown_job(result.job_id);
   JobState& job = *it->second;
@@ -232,8 +248,7 @@ Result<json> Coordinator::upload_result(uint64_t worker, uint64_t lease, std::st
     return make_error(Code::BadRequest, "bad_result", "the result's rectangle or samples do not match the unit");
   s.end_leases_if([&](const LeaseInfo& l) { return l.job == job.id() && l.unit == unit && l.worker == worker; });
   if (job.is_done(unit)) {
-    ++job.duplicates;
-    ++s.counters.duplicates;
+    s.check_duplicate(job, unit, worker, result.film);
     return json{{"accepted", false}, {"duplicate", true}};
   }
   try {
@@ -246,6 +261,9 @@ Result<json> Coordinator::upload_result(uint64_t worker, uint64_t lease, std::st
     return internal_error(e);
   }
   const uint64_t samples = job.unit_samples(unit);
+  // Another copy is still being rendered (speculative, or re-issued from a worker thought dead):
+  // its result will be checked against this one.
+  if (job.active_leases(unit) > 0) job.remember_digest(unit, tile_digest(result.film));
   (void)job.add_result(unit, std::move(result.film), worker);
   job.result_bytes += bytes.size();
   ++s.counters.done;
@@ -255,21 +273,26 @@ Result<json> Coordinator::upload_result(uint64_t worker, uint64_t lease, std::st
   w->units_done += 1;
   w->samples_done += samples;
   w->render_seconds += result.seconds;
-  if (job.complete()) {
-    job.phase = JobPhase::Done;
-    job.finished = wall_seconds();
-    try {
-      s.save_phase(job);
+  if (job.complete()) try {
+      s.change_phase(job, JobPhase::Done);
     } catch (const std::exception& e) {
       return internal_error(e);
     }
-    log_event(spdlog::level::info, "job.done",
-              {{"job", job.id()}, {"seconds", job.finished - job.started}, {"spp", job.spp_complete()},
-               {"stopped_at_target", job.converged()}});
-  }
   (void)lease;
   s.upload_seconds.observe(std::chrono::duration<double>(Clock::now() - t0).count());
   return json{{"accepted", true}, {"duplicate", false}};
+}
+
+void Coordinator::Impl::check_duplicate(JobState& job, size_t unit, uint64_t worker, const FilmTile& film) {
+  ++job.duplicates;
+  ++counters.duplicates;
+  const Sha256Digest* first = job.digest(unit);
+  if (!first || *first == tile_digest(film)) return;
+  // Renders are deterministic: a different answer for the same unit means a broken worker.
+  ++job.mismatched;
+  ++counters.mismatched;
+  log_event(spdlog::level::err, "result.mismatch",
+            {{"job", job.id()}, {"tile", job.tile_of(unit)}, {"pass", job.pass_of(unit)}, {"worker", worker}});
 }
 
 Status Coordinator::fail_lease(uint64_t worker, uint64_t lease, const json& body) {
@@ -292,20 +315,14 @@ Status Coordinator::fail_lease(uint64_t worker, uint64_t lease, const json& body
   log_event(spdlog::level::warn, "lease.failed", {{"lease", lease}, {"job", job.id()}, {"worker", worker}, {"reason", reason}});
   // The job fails when its work fails on several workers (or on every worker there is).
   size_t live = 0;
-  for (auto& [id, w] : s.workers) live += w.state == "idle" || w.state == "busy";
+  for (auto& [id, w] : s.workers) live += is_live(w.state);
   const size_t needed = std::max<size_t>(1, std::min<size_t>(size_t(s.opt.failed_workers_limit), live));
-  if (!is_terminal(job.phase) && job.failures_by_worker.size() >= needed) {
-    job.phase = JobPhase::Failed;
-    job.finished = wall_seconds();
-    job.error = "failed on " + std::to_string(job.failures_by_worker.size()) + " worker(s); last error: " + reason;
-    s.end_leases_if([&](const LeaseInfo& l) { return l.job == job.id(); });
-    log_event(spdlog::level::err, "job.failed", {{"job", job.id()}, {"reason", job.error}});
-  }
-  try {
-    s.save_phase(job);
-  } catch (const std::exception& e) {
-    return internal_error(e);
-  }
+  if (!is_terminal(job.phase) && job.failures_by_worker.size() >= needed) try {
+      s.change_phase(job, JobPhase::Failed,
+                     "failed on " + std::to_string(job.failures_by_worker.size()) + " worker(s); last error: " + reason);
+    } catch (const std::exception& e) {
+      return internal_error(e);
+    }
   return Status::success();
 }
 
@@ -315,7 +332,7 @@ Status Coordinator::sign_off(uint64_t worker, const json& body) {
   WorkerInfo* w = s.find_worker(worker);
   if (!w) return unknown_worker(worker);
   s.end_leases_if([&](const LeaseInfo& l) { return l.worker == worker; });
-  w->state = "gone";
+  s.set_worker_state(worker, *w, WorkerState::Gone);
   try {
     s.store.touch_worker(worker, wall_seconds(), "gone");
   } catch (const std::exception& e) {
@@ -330,8 +347,9 @@ Status Coordinator::drain_worker(uint64_t worker) {
   std::lock_guard<std::mutex> lock(s.mu);
   WorkerInfo* w = s.find_worker(worker);
   if (!w) return unknown_worker(worker);
-  if (w->state == "gone") return make_error(Code::Conflict, "worker_gone", "worker " + std::to_string(worker) + " signed off");
-  w->state = "draining";
+  if (w->state == WorkerState::Gone)
+    return make_error(Code::Conflict, "worker_gone", "worker " + std::to_string(worker) + " signed off");
+  s.set_worker_state(worker, *w, WorkerState::Draining);
   s.work_cv.notify_all();  // its waiting polls return now
   log_event(spdlog::level::info, "worker.draining", {{"worker", worker}});
   return Status::success();
@@ -345,7 +363,7 @@ Result<json> Coordinator::list_workers() {
     list.push_back({{"id", id},
                     {"name", w.row.name},
                     {"threads", w.row.threads},
-                    {"state", w.state},
+                    {"state", worker_state_name(w.state)},
                     {"units_done", w.units_done},
                     {"samples_done", w.samples_done},
                     {"samples_per_second", w.render_seconds > 0 ? double(w.samples_done) / w.render_seconds : 0.0}});

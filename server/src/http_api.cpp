@@ -25,6 +25,78 @@ void send_error(httplib::Response& res, const Status& s) {
   send_json(res, http_status(s.code), json{{"error", s.error}, {"detail", s.detail}});
 }
 
+// The largest body read: a bundle of --max-upload bytes plus room for a form's other fields.
+uint64_t max_body_bytes(uint64_t max_upload_bytes) {
+  const uint64_t form = uint64_t(16) << 20;
+  return max_upload_bytes > UINT64_MAX - form ? UINT64_MAX : max_upload_bytes + form;
+}
+
+// For refusals before the body is read: the unread body must not be taken for a next request.
+void refuse_and_close(httplib::Response& res, int status, const std::string& error, const std::string& detail) {
+  res.set_header("Connection", "close");
+  send_json(res, status, json{{"error", error}, {"detail", detail}});
+}
+
+std::string body_limit_text(uint64_t max_upload_bytes) {
+  return std::to_string(max_body_bytes(max_upload_bytes)) + " bytes (tessera-server --max-upload " +
+         std::to_string(max_upload_bytes) + " + 16 MiB for a form's other fields)";
+}
+
+// Why cpp-httplib refused a request itself (no handler ran).
+std::string transport_error_detail(const httplib::Request& req, int status, uint64_t max_upload_bytes) {
+  if (status == 404) return "no such endpoint: " + req.method + " " + req.path;
+  // Its only 413 left is a Content-Length over set_payload_max_length (forms never reach it).
+  if (status == 413)
+    return "the body has " + req.get_header_value("Content-Length") + " bytes; the limit is " + body_limit_text(max_upload_bytes);
+  return "the request was refused with HTTP " + std::to_string(status);
+}
+
+// cpp-httplib 0.11 bounds a body by its Content-Length only: a chunked body would be read into
+// memory without limit. No client of the farm sends one, so it is refused before it is read.
+// Bundles (scenes, jobs) may be as large as --max-upload, a tile result as its largest tile; every
+// other body is a small JSON message, so a heartbeat of 50 MB is refused unread.
+constexpr uint64_t kMaxMessageBytes = uint64_t(1) << 20, kMaxResultBytes = uint64_t(64) << 20;
+
+bool refused_large_message(const httplib::Request& req, httplib::Response& res) {
+  const bool bundle = req.path == "/api/v1/scenes" || req.path == "/api/v1/jobs";
+  if (bundle || !req.has_header("Content-Length")) return false;
+  const bool result = req.path.size() > 8 && req.path.compare(req.path.size() - 8, 8, "/results") == 0;
+  const uint64_t limit = result ? kMaxResultBytes : kMaxMessageBytes;
+  uint64_t length = 0;
+  try {
+    length = std::stoull(req.get_header_value("Content-Length"));
+  } catch (const std::exception&) {
+    return false;  // (httplib refuses a malformed length itself)
+  }
+  if (length <= limit) return false;
+  refuse_and_close(res, 413, "payload_too_large",
+                   "the body has " + std::to_string(length) + " bytes; " + (result ? "a tile result" : "this message") +
+                       " may have at most " + std::to_string(limit));
+  return true;
+}
+
+bool refused_chunked_body(const httplib::Request& req, httplib::Response& res) {
+  if (req.get_header_value("Transfer-Encoding").find("chunked") == std::string::npos) return false;
+  refuse_and_close(res, 411, "length_required", "send the body with a Content-Length (chunked bodies are not accepted)");
+  return true;
+}
+
+// Works around two cpp-httplib 0.11 habits, before it reads the body:
+// - a POST without Content-Length (curl -X POST URL) is read until the connection closes, i.e.
+//   until the read timeout, then refused with 400; RFC 9112 says such a request has no body.
+// - a body typed application/x-www-form-urlencoded (curl --data-binary's default) is parsed as a
+//   form and refused with 413 past 8 KB; the API takes no forms, so it is kept as plain bytes.
+// The request object is httplib's own, non-const one; only the handler's view of it is const.
+void normalise_body_headers(httplib::Request& req) {
+  const bool may_have_body = req.method == "POST" || req.method == "PUT" || req.method == "PATCH" || req.method == "DELETE";
+  if (may_have_body && !req.has_header("Content-Length") && !req.has_header("Transfer-Encoding"))
+    req.set_header("Content-Length", "0");
+  if (req.get_header_value("Content-Type").rfind("application/x-www-form-urlencoded", 0) == 0) {
+    req.headers.erase("Content-Type");
+    req.set_header("Content-Type", "application/octet-stream");
+  }
+}
+
 template <class T>
 void send(httplib::Response& res, const Result<T>& r, int ok_status = 200) {
   if (!r.ok()) return send_error(res, r.status);
@@ -77,7 +149,9 @@ std::string bundle_of(const httplib::Request& req) {
 
 }  // namespace
 
-void install_routes(httplib::Server& http, Coordinator& c, const AuthTokens& tokens, ConnectionGuard* guard) {
+void install_routes(httplib::Server& http, Coordinator& c, uint64_t max_upload_bytes, const AuthTokens& tokens,
+                    ConnectionGuard* guard) {
+  http.set_payload_max_length(size_t(max_body_bytes(max_upload_bytes)));
   auto peer = [](const httplib::Request& req) { return req.remote_addr + ":" + std::to_string(req.remote_port); };
   http.set_logger([guard, peer](const httplib::Request& req, const httplib::Response& res) {
     if (guard) guard->request_finished(peer(req));
@@ -88,12 +162,14 @@ void install_routes(httplib::Server& http, Coordinator& c, const AuthTokens& tok
   // connection is then closed). The answer is the same for a missing and a wrong token.
   http.set_pre_routing_handler([tokens, guard, peer](const httplib::Request& req, httplib::Response& res) {
     if (guard) guard->request_started(peer(req));
-    if (authorized(tokens, required_access(req.method, req.path), req.get_header_value("Authorization")))
-      return httplib::Server::HandlerResponse::Unhandled;
-    res.set_header("WWW-Authenticate", "Bearer");
-    res.set_header("Connection", "close");  // the unread body must not be taken for a next request
-    send_json(res, 401, json{{"error", "unauthorized"}, {"detail", "a valid bearer token is required"}});
-    return httplib::Server::HandlerResponse::Handled;
+    if (!authorized(tokens, required_access(req.method, req.path), req.get_header_value("Authorization"))) {
+      res.set_header("WWW-Authenticate", "Bearer");
+      refuse_and_close(res, 401, "unauthorized", "a valid bearer token is required");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    if (refused_chunked_body(req, res) || refused_large_message(req, res)) return httplib::Server::HandlerResponse::Handled;
+    normalise_body_headers(const_cast<httplib::Request&>(req));
+    return httplib::Server::HandlerResponse::Unhandled;
   });
 
   http.Get("/healthz", [&c](const httplib::Request&, httplib::Response& res) { send_json(res, 200, c.health()); });
@@ -183,7 +259,12 @@ void install_routes(httplib::Server& http, Coordinator& c, const AuthTokens& tok
   http.Post(R"(/api/v1/workers/(\d+)/heartbeat)", [&c](const httplib::Request& req, httplib::Response& res) {
     uint64_t id;
     json body;
-    if (parse_id(req, 1, id, res) && parse_body(req, res, body)) send(res, c.heartbeat(id, body));
+    if (!parse_id(req, 1, id, res) || !parse_body(req, res, body)) return;
+    std::vector<HeldLease> held;
+    std::string error;
+    if (!heartbeat_from_json(body, held, error))
+      return send_error(res, make_error(Code::BadRequest, "bad_heartbeat", error));
+    send(res, c.heartbeat(id, held));
   });
   http.Post(R"(/api/v1/workers/(\d+)/results)", [&c](const httplib::Request& req, httplib::Response& res) {
     uint64_t id;
@@ -202,13 +283,12 @@ void install_routes(httplib::Server& http, Coordinator& c, const AuthTokens& tok
     if (parse_id(req, 1, id, res) && parse_body(req, res, body)) send(res, c.sign_off(id, body));
   });
 
-  // Errors httplib produces itself (no route: 404; body over the limit: 413) get the JSON body too.
-  http.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
+  // Errors httplib produces itself (no route: 404; a body over max_body_bytes, which it reads and
+  // discards so that the client sees the answer: 413) get the JSON body too.
+  http.set_error_handler([max_upload_bytes](const httplib::Request& req, httplib::Response& res) {
     if (!res.body.empty()) return;
     const char* error = res.status == 404 ? "not_found" : res.status == 413 ? "payload_too_large" : "http_error";
-    std::string detail = res.status == 404 ? "no such endpoint: " + req.method + " " + req.path
-                                           : "the request was refused with HTTP " + std::to_string(res.status);
-    send_json(res, res.status, json{{"error", error}, {"detail", detail}});
+    send_json(res, res.status, json{{"error", error}, {"detail", transport_error_detail(req, res.status, max_upload_bytes)}});
   });
   http.set_exception_handler([](const httplib::Request& req, httplib::Response& res, std::exception_ptr ep) {
     std::string what = "unknown exception";

@@ -27,8 +27,7 @@ bool parse_phase(const std::string& s, JobPhase& out) {
 }
 
 JobState::JobState(uint64_t id, JobPlan plan, std::string name, int priority, double created)
-    : id_(id), plan_(std::move(plan)), name_(std::move(name)), priority_(priority), created_(created),
-      film_(std::make_unique<Film>(plan_.window, plan_.full_width, plan_.full_height)) {
+    : id_(id), plan_(std::move(plan)), name_(std::move(name)), priority_(priority), created_(created) {
   // The same cuts `tessera render` makes: pass_schedule is a function of spp alone.
   tiles_ = make_tiles(plan_.window, plan_.settings.tile_size);
   passes_ = pass_schedule(uint32_t(plan_.settings.spp));
@@ -43,6 +42,11 @@ JobState::JobState(uint64_t id, JobPlan plan, std::string name, int priority, do
   total_samples_ = uint64_t(plan_.window.area()) * uint64_t(plan_.settings.spp);
   pass_done_.assign(passes_.size(), 0);
   open_passes_ = plan_.settings.target_error > 0 ? std::min<size_t>(1, passes_.size()) : passes_.size();
+}
+
+Image JobState::image() const {
+  if (film_) return film_->to_image();
+  return Image(plan_.window.width(), plan_.window.height(), 3);
 }
 
 NoiseEstimate JobState::noise() const {
@@ -88,6 +92,7 @@ void JobState::mark_done(size_t unit, uint64_t worker) {
   done_samples_ += unit_samples(unit);
   samples_by_worker_[worker] += unit_samples(unit);
   while (first_open_ < done_.size() && done_[first_open_]) ++first_open_;
+  while (complete_passes_ < passes_.size() && pass_done_[complete_passes_] == tiles_.size()) ++complete_passes_;
 }
 
 bool JobState::add_result(size_t unit, FilmTile&& tile, uint64_t worker) {
@@ -100,6 +105,7 @@ bool JobState::add_result(size_t unit, FilmTile&& tile, uint64_t worker) {
 
   // Passes of a tile enter the film in pass order; a later pass waits for the earlier ones.
   const uint32_t t = tile_of(unit);
+  if (!film_ && !film_released_) film_ = std::make_unique<Film>(plan_.window, plan_.full_width, plan_.full_height);
   waiting_.emplace(unit, std::move(tile));
   for (auto it = waiting_.find(this->unit(t, next_pass_[t])); it != waiting_.end();
        it = waiting_.find(this->unit(t, next_pass_[t]))) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "tessera/farm/job_scene.h"
+#include "tessera/farm/sha256.h"
 #include "tessera/image/image.h"
 #include "tessera/render/film.h"
 #include "tessera/render/noise_estimate.h"
@@ -67,22 +68,37 @@ class JobState {
   /// The first unit, pass-major, that is neither done nor leased and that `worker` may take.
   std::optional<size_t> next_unit() const;
   void lease_started(size_t unit) { ++active_leases_[unit]; }
+  /// Leases of the unit in flight.
+  unsigned active_leases(size_t unit) const { return active_leases_[unit]; }
   void lease_ended(size_t unit);
   bool is_done(size_t unit) const { return done_[unit]; }
+  /// The digest of a unit's accepted sums, kept when another copy of it was in flight (also once
+  /// the job has ended: that copy's result may still arrive).
+  void remember_digest(size_t unit, const Sha256Digest& d) { digests_[unit] = d; }
+  const Sha256Digest* digest(size_t unit) const {
+    auto it = digests_.find(unit);
+    return it == digests_.end() ? nullptr : &it->second;
+  }
   /// Adds a verified result; false when the unit was already done (a duplicate).
   bool add_result(size_t unit, FilmTile&& tile, uint64_t worker);
   /// Marks a unit done without its sums (a finished job resumed from its stored image).
   void mark_done(size_t unit, uint64_t worker);
 
   /// Mean radiance over the film window (zero where no pass has arrived). Only with has_film().
-  Image image() const { return film_->to_image(); }
+  Image image() const;
+  /// The sums so far; only once a result has arrived (film_allocated()).
   const Film& film() const { return *film_; }
-  /// A finished job's film is dropped once its image is on disk (a 1080p film holds 116 MB of
-  /// sums); the image is then served from the file.
-  bool has_film() const { return film_ != nullptr; }
+  /// The film is allocated when the first result arrives, not at submission: a queue of jobs (a
+  /// frame range) costs no film memory until each one renders.
+  bool film_allocated() const { return film_ != nullptr; }
+  /// The image is in memory (the film, or black before any result). A finished job's film is
+  /// dropped once its image is on disk (a 1080p film holds 116 MB of sums); the image is then
+  /// served from the file.
+  bool has_film() const { return !film_released_; }
   void release_film() {
     if (film_) (void)noise();  // kept for the finished job's status
     film_.reset();
+    film_released_ = true;
     waiting_.clear();
   }
   const RenderCounters& counters() const { return counters_; }
@@ -97,6 +113,7 @@ class JobState {
   std::map<uint64_t, int> failures_by_worker;
   std::string last_failure;
   uint64_t duplicates = 0;
+  uint64_t mismatched = 0;  // duplicates whose sums differed from the accepted result's
   uint64_t result_bytes = 0;  // compressed bytes of the accepted results (the network cost)
   uint64_t lease_bytes = 0;   // JSON bytes of the leases handed out
 
@@ -112,6 +129,7 @@ class JobState {
   std::vector<uint16_t> active_leases_;
   std::vector<uint32_t> next_pass_;              // per tile: passes already in the film
   std::map<size_t, FilmTile> waiting_;           // results that arrived before an earlier pass
+  std::map<size_t, Sha256Digest> digests_;       // see remember_digest
   void advance_passes();
 
   size_t done_units_ = 0, first_open_ = 0;
@@ -124,7 +142,20 @@ class JobState {
   uint64_t total_samples_ = 0, done_samples_ = 0;
   std::map<uint64_t, uint64_t> samples_by_worker_;
   std::unique_ptr<Film> film_;
+  bool film_released_ = false;
   RenderCounters counters_;
 };
+
+/// SHA-256 of a result's pixel sums: what two renders of one unit must agree on (the worker's
+/// timing in the result bytes differs).
+inline Sha256Digest tile_digest(const FilmTile& film) {
+  return sha256(film.pixels().data(), film.pixels().size() * sizeof(PixelSums));
+}
+
+/// The samples per pixel an image of the job holds once finished: the spp reached when it stopped
+/// at its target error, else its spp (what the EXR header's tessera_spp says).
+inline uint32_t image_spp(const JobState& job) {
+  return job.converged() ? job.spp_complete() : uint32_t(job.plan().settings.spp);
+}
 
 }  // namespace tessera::server

@@ -2,12 +2,14 @@
 
 #include "connection_guard.h"
 #include "event_log.h"
+#include "scene_planner.h"
 #include "tessera/farm/protocol.h"
 #include "tessera/server/http_api.h"
 
 #include <httplib.h>
 #include <spdlog/spdlog.h>
 
+#include <malloc.h>
 #include <signal.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
@@ -63,7 +65,14 @@ pid_t spawn_worker(const std::string& binary, const std::string& url, int thread
 
 }  // namespace
 
+int run_scene_planner_main() { return run_scene_planner(stdin, stdout); }
+
 int run_server(const ServerOptions& o) {
+  // Buffers of 1 MiB and more (images being written or served, films) are mapped and given back
+  // to the system when freed. Without a fixed threshold glibc raises it after the first large
+  // free and serves later ones from per-thread heaps, which keep their peak: the coordinator's
+  // resident memory then grows with every image it ever wrote (bench/coordinator_memory.sh).
+  mallopt(M_MMAP_THRESHOLD, 1 << 20);
   // Signals are taken synchronously by this thread (sigtimedwait), so every other thread,
   // including httplib's, runs with them blocked.
   sigset_t signals;
@@ -106,7 +115,12 @@ int run_server(const ServerOptions& o) {
 
   std::unique_ptr<Coordinator> coordinator;
   try {
-    coordinator = std::make_unique<Coordinator>(o.coordinator);
+    CoordinatorOptions copt = o.coordinator;
+    // This very program plans scenes in a child (`--plan-scene`): the coordinator's memory stays
+    // that of its bookkeeping, however large the scenes submitted.
+    std::error_code ec;
+    if (copt.scene_planner.empty()) copt.scene_planner = fs::read_symlink("/proc/self/exe", ec).string();
+    coordinator = std::make_unique<Coordinator>(copt);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "tessera-server: cannot use data directory '%s': %s\n", o.coordinator.data_dir.c_str(), e.what());
     return 1;
@@ -132,7 +146,6 @@ int run_server(const ServerOptions& o) {
   // workers cannot pin the pool.
   http.set_keep_alive_timeout(2);
   http.set_read_timeout(60);
-  http.set_payload_max_length(size_t(o.coordinator.max_upload_bytes) + (size_t(16) << 20));
   // cpp-httplib 0.11 listens with a backlog of 5; a few hundred workers connecting at once would
   // overflow it (dropped handshakes, failed requests). Keep the socket and widen the backlog after
   // bind: listen() on a listening socket only changes its backlog.
@@ -148,7 +161,7 @@ int run_server(const ServerOptions& o) {
   }
   if (listen_fd >= 0) ::listen(listen_fd, 4096);
   ConnectionGuard guard(bound, o.header_timeout);
-  install_routes(http, *coordinator, tokens, &guard);
+  install_routes(http, *coordinator, o.coordinator.max_upload_bytes, tokens, &guard);
   if (!o.port_file.empty()) std::ofstream(o.port_file) << bound << "\n";
   const std::string local_host = host == "0.0.0.0" || host == "::" ? std::string("127.0.0.1") : host;
   const std::string url = (tls ? "https://" : "http://") + local_host + ":" + std::to_string(bound);

@@ -17,8 +17,11 @@ int parse_server_args(int argc, char** argv, ServerOptions& o) {
   app.add_option("--local-workers", o.local_workers, "also run N workers on this machine")->check(CLI::Range(0, 256));
   app.add_option("--local-worker-threads", o.local_worker_threads, "threads per local worker (default: cores / N)");
   app.add_option("--worker-binary", o.worker_binary, "the tessera-worker program for --local-workers");
-  app.add_option("--lease-timeout", c.lease_timeout, "seconds without a heartbeat before a lease is re-issued")
-      ->check(CLI::Range(0.5, 3600.0))->capture_default_str();
+  app.add_option("--heartbeat-interval", c.heartbeat_interval,
+                 "seconds between worker heartbeats; a worker silent for 3 intervals is dead and its leases re-issued")
+      ->check(CLI::Range(0.1, 600.0))->capture_default_str();
+  app.add_flag("!--no-speculation", c.speculate,
+               "never lease a second copy of an outstanding unit to an idle worker (each unit is leased once)");
   app.add_option("--max-poll-wait", c.max_poll_wait, "longest lease long poll, seconds")
       ->check(CLI::Range(0.0, 30.0))->capture_default_str();
 
@@ -40,6 +43,9 @@ int parse_server_args(int argc, char** argv, ServerOptions& o) {
   app.add_option("--max-upload", c.max_upload_bytes, "largest scene bundle accepted, bytes")->capture_default_str()->group(limits);
   app.add_option("--max-unpacked", c.bundle_limits.max_unpacked_bytes, "largest unpacked bundle, bytes")
       ->capture_default_str()->group(limits);
+  app.add_option("--max-ratio", c.bundle_limits.max_ratio,
+                 "a bundle may unpack to at most 8 MiB + this many times its own size (decompression bombs); 0: no ratio limit")
+      ->check(CLI::NonNegativeNumber)->capture_default_str()->group(limits);
   app.add_option("--max-files", c.bundle_limits.max_files, "most entries in a bundle")->capture_default_str()->group(limits);
   app.add_option("--max-spp", c.limits.max_spp, "most samples per pixel of a job")
       ->check(CLI::PositiveNumber)->capture_default_str()->group(limits);

@@ -200,6 +200,23 @@ uint64_t Store::leases_issued(uint64_t job) {
   return uint64_t(st.i(0));
 }
 
+std::vector<LeaseRow> Store::open_leases(uint64_t job) {
+  Stmt st(db_,
+          "SELECT l.seq, l.tile, l.pass, l.worker FROM leases l WHERE l.job = ? "
+          "AND l.seq = (SELECT MAX(m.seq) FROM leases m WHERE m.job = l.job AND m.pass = l.pass AND m.tile = l.tile) "
+          "AND NOT EXISTS (SELECT 1 FROM results r WHERE r.job = l.job AND r.pass = l.pass AND r.tile = l.tile)");
+  st.bind(int64_t(job));
+  std::vector<LeaseRow> rows;
+  while (st.step()) rows.push_back({uint64_t(st.i(0)), uint32_t(st.i(1)), uint32_t(st.i(2)), uint64_t(st.i(3))});
+  return rows;
+}
+
+std::pair<uint64_t, uint64_t> Store::lease_and_result_counts() {
+  Stmt st(db_, "SELECT (SELECT COUNT(*) FROM leases), (SELECT COUNT(*) FROM results)");
+  st.step();
+  return {uint64_t(st.i(0)), uint64_t(st.i(1))};
+}
+
 std::vector<std::pair<uint64_t, uint64_t>> Store::result_bytes(const std::vector<uint64_t>& ids) {
   std::vector<std::pair<uint64_t, uint64_t>> out;
   if (ids.empty()) {

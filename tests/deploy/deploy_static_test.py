@@ -139,8 +139,8 @@ def check_dockerfile(c, root, flags):
     stages = df.stages()
     build_runs = " ".join(i.args for i in stages[0] if i.op == "RUN")
     final_runs = " ".join(i.args for i in stages[-1] if i.op == "RUN")
-    c.check(re.search(r"scripts/install-deps\.sh(\s|&|;|$)", build_runs) is not None,
-            "Dockerfile: the build stage runs scripts/install-deps.sh (as CI does)")
+    c.check(re.search(r"scripts/install-deps\.sh\s+--build(\s|&|;|$)", build_runs) is not None,
+            "Dockerfile: the build stage runs scripts/install-deps.sh --build (no test packages)")
     c.check("install-deps.sh --runtime" in final_runs, "Dockerfile: the runtime stage runs install-deps.sh --runtime")
     targets = re.search(r"--target\s+([\w\s-]+?)(?:&&|\\|$)", build_runs)
     c.check(targets is not None and {"tessera", "tessera-server", "tessera-worker"} <= set(targets.group(1).split()),
@@ -152,6 +152,7 @@ def check_dockerfile(c, root, flags):
     for sample in ("build/CMakeCache.txt", "build-deploy/server/tessera-server", "out/demo.png", ".git/HEAD"):
         c.check(ignored(rules, sample), f".dockerignore excludes {sample.split('/')[0]}/")
     copied = set()
+    whole_context = False
     for ins in df.instructions:
         if ins.op not in ("COPY", "ADD"):
             continue
@@ -160,6 +161,11 @@ def check_dockerfile(c, root, flags):
             continue
         words = [w for w in words if not w.startswith("--")]
         for src in words[:-1]:
+            if os.path.normpath(src) == ".":
+                # The whole context: it holds what .dockerignore does not leave out.
+                whole_context = True
+                copied.update(e for e in os.listdir(root) if not ignored(rules, e))
+                continue
             full = os.path.join(root, src)
             hidden = [src] if ignored(rules, os.path.normpath(src)) else []
             for dirpath, _, files in os.walk(full):
@@ -174,6 +180,13 @@ def check_dockerfile(c, root, flags):
     needed = [d for d in subdirs if d != "tests"] + ["CMakeLists.txt"]
     c.check(all(d in copied for d in needed), "Dockerfile: copies every folder the top CMakeLists.txt adds",
             f"missing {[d for d in needed if d not in copied]}")
+    if whole_context:
+        hidden = [os.path.relpath(os.path.join(dirpath, f), root)
+                  for d in needed if os.path.isdir(os.path.join(root, d))
+                  for dirpath, _, files in os.walk(os.path.join(root, d)) for f in files
+                  if ignored(rules, os.path.relpath(os.path.join(dirpath, f), root))]
+        c.check(not hidden, "Dockerfile: .dockerignore leaves out no file of the folders the build adds",
+                f"ignored: {hidden[:5]}")
     if "tests" not in copied:
         c.check("-DTESSERA_BUILD_TESTS=OFF" in build_runs, "Dockerfile: tests/ not copied, so TESSERA_BUILD_TESTS=OFF")
 
@@ -200,10 +213,33 @@ def check_dockerfile(c, root, flags):
     return entry, cmd
 
 
-def runtime_packages(root):
-    out = subprocess.run(["bash", os.path.join(root, "scripts", "install-deps.sh"), "--list-runtime"],
+def listed_packages(root, mode):
+    out = subprocess.run(["bash", os.path.join(root, "scripts", "install-deps.sh"), mode],
                          capture_output=True, text=True, timeout=30)
     return set(out.stdout.split()) if out.returncode == 0 else set()
+
+
+def runtime_packages(root):
+    return listed_packages(root, "--list-runtime")
+
+
+# Packages only the tests use: the image's build stage (install-deps.sh --build) must not install them.
+TEST_ONLY = {"libgtest-dev", "libgmock-dev", "python3-yaml", "iproute2", "chromium", "chromium-driver",
+             "python3-selenium", "podman", "podman-compose", "buildah", "runc", "debootstrap"}
+
+
+def check_install_modes(c, root):
+    full, build = listed_packages(root, "--list"), listed_packages(root, "--list-build")
+    if not c.check(bool(full) and bool(build), "install-deps.sh --list and --list-build list packages"):
+        return
+    c.check(build <= full, "install-deps.sh: the default installs everything --build does",
+            f"only in --build: {sorted(build - full)}")
+    c.check(not build & TEST_ONLY, "install-deps.sh --build installs no test-only package",
+            f"{sorted(build & TEST_ONLY)}")
+    c.check({"build-essential", "cmake", "ninja-build"} <= build, "install-deps.sh --build installs a compiler, CMake and Ninja")
+    need = {"podman", "podman-compose", "debootstrap"}
+    c.check(need <= full, "install-deps.sh (default, what CI runs) installs the container test's tools",
+            f"missing {sorted(need - full)}")
 
 
 def check_runtime_libraries(c, root, bins):
@@ -285,7 +321,10 @@ def check_compose(c, docs, image, flags):
     c.check({"TESSERA_CLIENT_TOKEN", "TESSERA_WORKER_TOKEN"} <= set(env_c), "compose: coordinator gets both tokens")
     c.check("TESSERA_WORKER_TOKEN" in env_w and "TESSERA_CLIENT_TOKEN" not in env_w,
             "compose: worker gets the worker token only")
-    c.check("coordinator" in (worker.get("depends_on") or {}), "compose: worker depends on the coordinator")
+    deps = worker.get("depends_on") or {}
+    c.check("coordinator" in deps, "compose: worker depends on the coordinator")
+    c.check(not (isinstance(deps, dict) and "service_healthy" in str(deps.get("coordinator"))),
+            "compose: workers do not wait for the coordinator's health (podman-compose cannot; workers retry)")
 
 
 def check_docs(c, root, flags):
@@ -315,6 +354,7 @@ def main():
     flags = FlagChecker(c, bins)
     docs = load_yaml_files(c, a.root)
     image = check_dockerfile(c, a.root, flags) or (["tessera-server"], [])
+    check_install_modes(c, a.root)
     check_runtime_libraries(c, a.root, bins)
     check_compose(c, docs, image, flags)
     check_kubernetes(c, docs, image, flags)

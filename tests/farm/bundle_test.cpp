@@ -205,6 +205,29 @@ TEST(BundleRefused, UnpackedSizeOverTheLimit) {
   EXPECT_TRUE(inspect_bundle(ArchiveBuilder(Format::TarGz).file("a", half).finish(), limits).ok());
 }
 
+TEST(BundleRefused, CompressionRatioOverTheDefaultLimit) {
+  // Zeros inflate about 1000:1; real scenes stay under 10:1 (docs/api.md, Limits).
+  const std::string zeros(20 << 20, '\0');
+  for (Format f : {Format::TarGz, Format::Zip}) {
+    const std::string bomb = ArchiveBuilder(f).file("scene.xml", "x").file("big.bin", zeros).finish();
+    ASSERT_LT(bomb.size(), 100000u);
+    expect_refused(bomb, "bundle entry 'big.bin': unpacked size exceeds " +
+                             std::to_string(BundleLimits{}.unpacked_limit(bomb.size())) +
+                             " bytes, the compression-ratio limit");
+    BundleLimits no_ratio;
+    no_ratio.max_ratio = 0;
+    EXPECT_TRUE(inspect_bundle(bomb, no_ratio).ok());
+  }
+  // Under the floor the ratio does not matter: a tiny scene of zeros is fine.
+  EXPECT_TRUE(inspect_bundle(ArchiveBuilder(Format::TarGz).file("a", std::string(4 << 20, '\0')).finish()).ok());
+  // The smaller limit wins, and a huge ratio cannot overflow.
+  BundleLimits limits;
+  EXPECT_EQ(limits.unpacked_limit(1000), (uint64_t(8) << 20) + 200000);
+  EXPECT_EQ(limits.unpacked_limit(uint64_t(4) << 30), limits.max_unpacked_bytes);
+  limits.max_ratio = 1e300;
+  EXPECT_EQ(limits.unpacked_limit(1), limits.max_unpacked_bytes);
+}
+
 /// Rewrites the uncompressed size of every zip header (local, central, data descriptor) that
 /// holds `from` into `to`: a zip whose headers lie about how much its deflate stream inflates to.
 std::string patch_zip_sizes(std::string zip, uint32_t from, uint32_t to) {

@@ -1,49 +1,12 @@
 // The coordinator's services in-process (no HTTP): exclusion of failing workers, job failure with
 // the reason, and state that survives a restart.
-#include "tessera/farm/build_fingerprint.h"
-#include "tessera/farm/bundle.h"
-#include "tessera/farm/job_scene.h"
-#include "tessera/farm/tile_result.h"
-#include "tessera/render/renderer.h"
-#include "tessera/scene/load_context.h"
-#include "tessera/scene/scene_desc.h"
-#include "tessera/server/coordinator.h"
-#include "test_support.h"
+#include "coordinator_fixture.h"
 
 namespace tessera::test {
 namespace {
 
 using nlohmann::json;
 using server::Coordinator;
-using server::CoordinatorOptions;
-
-constexpr const char* kXml = R"(<scene version="0.6.0">
-  <sensor type="perspective"><float name="fov" value="45"/>
-    <sampler type="independent"><integer name="sampleCount" value="5"/></sampler>
-    <film type="hdrfilm"><integer name="width" value="20"/><integer name="height" value="12"/></film>
-  </sensor>
-  <shape type="sphere"><point name="center" x="0" y="0" z="4"/></shape>
-  <emitter type="constant"/>
-</scene>)";
-
-std::string bundle() {
-  TempDir src;
-  src.write("scene.xml", kXml);
-  return pack_bundle(src.path.string(), {"scene.xml"});
-}
-
-uint64_t add_worker(Coordinator& c, const std::string& name) {
-  const BuildFingerprint& fp = build_fingerprint();
-  auto r = c.register_worker(json{{"name", name}, {"version", fp.version}, {"isa", fp.isa}, {"probe", fp.probe}});
-  EXPECT_TRUE(r.ok()) << r.status.detail;
-  return r.value.value("id", uint64_t(0));
-}
-
-CoordinatorOptions options(const TempDir& dir) {
-  CoordinatorOptions o;
-  o.data_dir = (dir.path / "data").string();
-  return o;
-}
 
 TEST(Coordinator, FailingWorkersAreKeptOffAndThenTheJobFails) {
   TempDir dir;
@@ -119,19 +82,6 @@ TEST(Coordinator, StateSurvivesARestart) {
   EXPECT_TRUE(l.value.is_object());
   EXPECT_EQ(again.job_status(id).value["reissued_acknowledged_passes"], 0);
   EXPECT_EQ(again.list_jobs().value["jobs"].size(), 1u);
-}
-
-// Leases and delivers one unit for real; false when there was nothing to lease.
-bool deliver_one(Coordinator& c, uint64_t worker, const Scene& scene, uint32_t seed) {
-  json l = c.lease(worker, 0).value;
-  if (!l.is_object()) return false;
-  Lease lease;
-  std::string error;
-  EXPECT_TRUE(lease_from_json(l, lease, error)) << error;
-  lease.settings.seed = seed;
-  auto up = c.upload_result(worker, lease.id, encode_tile_result(render_lease(scene, lease)));
-  EXPECT_TRUE(up.ok()) << up.status.detail;
-  return true;
 }
 
 TEST(Coordinator, FinishedJobIsServedFromItsImageAfterARestart) {

@@ -17,7 +17,7 @@ using nlohmann::json;
 std::string cornell() { return shared_path("scenes/cornell-box/scene.xml"); }
 
 // Asserts status and that the body is {"error": ..., "detail": ...}; returns the detail.
-std::string expect_error(const farm::HttpReply& r, int status) {
+std::string expect_error(const client::HttpReply& r, int status) {
   EXPECT_EQ(r.status, status) << r.body;
   json j = r.json();
   EXPECT_TRUE(j.is_object() && j.contains("error") && j.contains("detail")) << r.body;
@@ -37,8 +37,8 @@ class FarmApi : public ::testing::Test {
     // Whatever was thrown at it, the coordinator is healthy.
     EXPECT_TRUE(farm_.client().get("/healthz", 5).ok());
   }
-  farm::HttpReply post_job(const json& settings, const std::string& bundle) {
-    return farm_.client().post_job_with_bundle(settings, bundle);
+  client::HttpReply post_job(const json& settings, const std::string& bundle) {
+    return farm_.api().submit_job(settings, bundle);
   }
   Farm farm_;
 };
@@ -83,8 +83,8 @@ TEST_F(FarmApi, HostileAndBrokenBundlesAreRefused) {
     expect_error(post_job(json::object(), k.bundle), 400);
   }
   // A good bundle is stored once, by hash.
-  farm::HttpReply a = c.post_bytes("/api/v1/scenes", good, "application/gzip");
-  farm::HttpReply b = c.post_bytes("/api/v1/scenes", good, "application/gzip");
+  client::HttpReply a = c.post_bytes("/api/v1/scenes", good, "application/gzip");
+  client::HttpReply b = c.post_bytes("/api/v1/scenes", good, "application/gzip");
   ASSERT_EQ(a.status, 201) << a.body;
   EXPECT_EQ(a.json()["hash"], b.json()["hash"]);
   EXPECT_EQ(c.get("/api/v1/scenes/" + a.json()["hash"].get<std::string>()).body, good);
@@ -121,7 +121,7 @@ TEST_F(FarmApi, WorkerProtocolRefusesBadBuildsAndBadResults) {
   detail = expect_error(c.post_json("/api/v1/workers", json{{"version", "0.0.1"}, {"isa", fp.isa}, {"probe", fp.probe}}), 409);
   EXPECT_NE(detail.find("version"), std::string::npos) << detail;
 
-  farm::HttpReply reg = c.post_json("/api/v1/workers", json{{"name", "fake"}, {"version", fp.version}, {"isa", fp.isa},
+  client::HttpReply reg = c.post_json("/api/v1/workers", json{{"name", "fake"}, {"version", fp.version}, {"isa", fp.isa},
                                                             {"probe", fp.probe}});
   ASSERT_EQ(reg.status, 201) << reg.body;
   const std::string w = "/api/v1/workers/" + std::to_string(reg.json()["id"].get<uint64_t>());
@@ -138,7 +138,7 @@ TEST_F(FarmApi, WorkerProtocolRefusesBadBuildsAndBadResults) {
   settings.tile_size = 16;
   uint64_t id = farm_.submit(cornell(), settings);
   ASSERT_GT(id, 0u);
-  farm::HttpReply lr = c.post_json(w + "/lease?wait=5", json::object());
+  client::HttpReply lr = c.post_json(w + "/lease?wait=5", json::object());
   ASSERT_EQ(lr.status, 200) << lr.body;
   Lease lease;
   std::string error;
@@ -163,10 +163,10 @@ TEST_F(FarmApi, WorkerProtocolRefusesBadBuildsAndBadResults) {
   other_job.job_id = 4242;
   expect_error(post(encode_tile_result(other_job)), 404);
 
-  farm::HttpReply ok = post(bytes);
+  client::HttpReply ok = post(bytes);
   ASSERT_EQ(ok.status, 200) << ok.body;
   EXPECT_EQ(ok.json()["accepted"], true);
-  farm::HttpReply dup = post(bytes);
+  client::HttpReply dup = post(bytes);
   ASSERT_EQ(dup.status, 200) << dup.body;
   EXPECT_EQ(dup.json()["duplicate"], true);
   json st = farm_.status(id);
@@ -175,7 +175,7 @@ TEST_F(FarmApi, WorkerProtocolRefusesBadBuildsAndBadResults) {
 
   // Failing the job's work on every worker there is fails the job, with the reason.
   for (int i = 0; i < 3; ++i) {
-    farm::HttpReply l = c.post_json(w + "/lease?wait=5", json::object());
+    client::HttpReply l = c.post_json(w + "/lease?wait=5", json::object());
     if (l.status != 200) break;
     (void)c.post_json(w + "/leases/" + std::to_string(l.json()["id"].get<uint64_t>()) + "/fail",
                       json{{"error", "out of memory on purpose"}});
@@ -200,7 +200,7 @@ TEST(FarmServing, MetricsAgreeWithTheJob) {
   uint64_t id = farm.submit(cornell(), s);
   json st = farm.wait_job(id);
   ASSERT_EQ(st["state"], "done");
-  farm::HttpReply r = farm.client().get("/metrics");
+  client::HttpReply r = farm.client().get("/metrics");
   ASSERT_EQ(r.status, 200);
   std::map<std::string, double> values;
   std::istringstream in(r.body);
@@ -240,7 +240,7 @@ TEST(FarmServing, WaitingWorkersNeverStarveClients) {
   const BuildFingerprint& fp = build_fingerprint();
   std::vector<std::string> paths;
   for (int i = 0; i < kPollers; ++i) {
-    farm::HttpReply reg = c.post_json("/api/v1/workers", json{{"name", "poller" + std::to_string(i)},
+    client::HttpReply reg = c.post_json("/api/v1/workers", json{{"name", "poller" + std::to_string(i)},
                                                               {"version", fp.version}, {"isa", fp.isa}, {"probe", fp.probe}});
     ASSERT_EQ(reg.status, 201);
     paths.push_back("/api/v1/workers/" + std::to_string(reg.json()["id"].get<uint64_t>()) + "/lease?wait=8");
@@ -250,7 +250,7 @@ TEST(FarmServing, WaitingWorkersNeverStarveClients) {
   for (const auto& p : paths)
     pollers.emplace_back([&, p] {
       auto t0 = std::chrono::steady_clock::now();
-      farm::HttpReply r = c.post_json(p, json::object(), 20);
+      client::HttpReply r = c.post_json(p, json::object(), 20);
       answered += r.status == 204;
       if (r.status != 204)
         std::printf("poll: %s after %.2f s\n", r.describe().c_str(),

@@ -8,6 +8,7 @@
 #include "farm_harness.h"
 #include "raw_http.h"
 #include "tessera/farm/build_fingerprint.h"
+#include "tessera/farm/sha256.h"
 
 #include <atomic>
 #include <random>
@@ -44,11 +45,11 @@ TEST(FarmAttack, EveryAttackIsRefusedAndAcceptedWorkSurvives) {
   TESSERA_REQUIRE_FILE(cornell());
   Farm farm({"--client-token", kClient, "--worker-token", kWorker, "--max-upload", "2000000", "--max-unpacked",
              "67108864", "--max-files", "50", "--max-spp", "4096", "--max-resolution", "4096", "--max-tiles", "20000",
-             "--max-active-jobs", "3", "--header-timeout", "1.5", "--http-threads", "8", "--lease-timeout", "2"});
+             "--max-active-jobs", "3", "--header-timeout", "1.5", "--http-threads", "8", "--heartbeat-interval", "0.7"});
   farm.set_tokens(kClient, kWorker);
   farm.start_server();
-  const farm::FarmClient client = farm.client();
-  const farm::FarmClient worker_client(farm.url(), kWorker);
+  const client::FarmClient http = farm.client();
+  const client::FarmClient worker_client(farm.url(), kWorker);
   const int port = farm.port();
 
   // Before: job B rendered to the end, job A accepted and waiting for a worker.
@@ -62,7 +63,7 @@ TEST(FarmAttack, EveryAttackIsRefusedAndAcceptedWorkSurvives) {
   ASSERT_GT(b, 0u);
   ASSERT_EQ(farm.wait_job(b).value("state", ""), "done");
   ASSERT_EQ(farm.worker(0).terminate(), 0);
-  const std::string image_b = client.get("/api/v1/jobs/" + std::to_string(b) + "/image?format=exr").body;
+  const std::string image_b = http.get("/api/v1/jobs/" + std::to_string(b) + "/image?format=exr").body;
   s.seed = 7;
   const uint64_t a = farm.submit(cornell(), s);
   ASSERT_GT(a, 0u);
@@ -71,15 +72,15 @@ TEST(FarmAttack, EveryAttackIsRefusedAndAcceptedWorkSurvives) {
   // 1. Tokens: none, a guess, the other role's.
   for (const char* path : {"/api/v1/jobs", "/metrics", "/api/v1/workers"}) {
     for (const std::string token : {"", "guess", kWorker})
-      tally.expect_refused(farm::FarmClient(farm.url(), token).get(path).status == 401, std::string(path) + " with '" + token + "'");
+      tally.expect_refused(client::FarmClient(farm.url(), token).get(path).status == 401, std::string(path) + " with '" + token + "'");
   }
-  tally.expect_refused(farm::FarmClient(farm.url(), kClient).post_json("/api/v1/workers", json::object()).status == 401,
+  tally.expect_refused(client::FarmClient(farm.url(), kClient).post_json("/api/v1/workers", json::object()).status == 401,
                        "a client registering as a worker");
 
   // 2. Oversized bodies: a bundle over --max-upload, a body over the transport's limit.
-  tally.expect_refused(client.post_bytes("/api/v1/scenes", noise(2100000, 1), "application/gzip").status == 413,
+  tally.expect_refused(http.post_bytes("/api/v1/scenes", noise(2100000, 1), "application/gzip").status == 413,
                        "bundle over --max-upload");
-  tally.expect_refused(is_refusal(client.post_bytes("/api/v1/jobs", std::string(40u << 20, '{'), "application/json", 60).status),
+  tally.expect_refused(is_refusal(http.post_bytes("/api/v1/jobs", std::string(40u << 20, '{'), "application/json", 60).status),
                        "40 MB JSON body");
 
   // 3. Hostile bundles.
@@ -97,10 +98,10 @@ TEST(FarmAttack, EveryAttackIsRefusedAndAcceptedWorkSurvives) {
     for (int i = 0; i < 60; ++i) many.file("f" + std::to_string(i), "x");
     const std::string files = many.finish();
     for (const auto& [what, bundle] : bundles) {
-      tally.expect_refused(client.post_bytes("/api/v1/scenes", bundle, "application/gzip").status == 400, what);
-      tally.expect_refused(client.post_job_with_bundle(json::object(), bundle).status == 400, what + " with a job");
+      tally.expect_refused(http.post_bytes("/api/v1/scenes", bundle, "application/gzip").status == 400, what);
+      tally.expect_refused(client::FarmApi(http).submit_job(json::object(), bundle).status == 400, what + " with a job");
     }
-    tally.expect_refused(client.post_bytes("/api/v1/scenes", files, "application/gzip").status == 400, "60 files");
+    tally.expect_refused(http.post_bytes("/api/v1/scenes", files, "application/gzip").status == 400, "60 files");
     std::printf("bomb bundle: %zu bytes for %u unpacked\n", bundles[5].second.size(), 100u << 20);
   }
 
@@ -108,17 +109,17 @@ TEST(FarmAttack, EveryAttackIsRefusedAndAcceptedWorkSurvives) {
   const std::string scene_ok = tgz("scene.xml", kXml);
   for (const json& bad : {json{{"spp", 100000}}, json{{"width", 100000}, {"height", 10}}, json{{"width", 4096}, {"height", 4096}, {"tile_size", 4}},
                           json{{"tile_size", 2}}, json{{"spp", -1}}, json{{"seed", "x"}}, json{{"defines", 3}}})
-    tally.expect_refused(is_refusal(client.post_job_with_bundle(bad, scene_ok).status), "settings " + bad.dump());
+    tally.expect_refused(is_refusal(client::FarmApi(http).submit_job(bad, scene_ok).status), "settings " + bad.dump());
 
   // 5. A flood of jobs: --max-active-jobs 3 holds A and two more.
   std::vector<uint64_t> flood;
   for (int i = 0; i < 6; ++i) {
-    farm::HttpReply r = client.post_job_with_bundle(json{{"spp", 1}, {"width", 8}, {"height", 8}}, scene_ok);
+    client::HttpReply r = client::FarmApi(http).submit_job(json{{"spp", 1}, {"width", 8}, {"height", 8}}, scene_ok);
     if (r.status == 201) flood.push_back(r.json()["id"].get<uint64_t>());
     else tally.expect_refused(r.status == 429, "job beyond --max-active-jobs");
   }
   EXPECT_EQ(flood.size(), 2u);
-  for (uint64_t id : flood) EXPECT_TRUE(client.del("/api/v1/jobs/" + std::to_string(id)).ok());
+  for (uint64_t id : flood) EXPECT_TRUE(http.del("/api/v1/jobs/" + std::to_string(id)).ok());
 
   // 6. Slow-loris: more trickling connections than HTTP threads. Each must be cut by the server
   // (not by us giving up after 20 s), and a real client is answered meanwhile.
@@ -141,7 +142,7 @@ TEST(FarmAttack, EveryAttackIsRefusedAndAcceptedWorkSurvives) {
         cut += std::chrono::steady_clock::now() < give_up;
       });
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
-    EXPECT_TRUE(client.get("/healthz", 15).ok()) << "a client is answered during the attack";
+    EXPECT_TRUE(http.get("/healthz", 15).ok()) << "a client is answered during the attack";
     for (auto& t : slow) t.join();
     for (int i = 0; i < kSlow; ++i) tally.expect_refused(seconds[size_t(i)] < 20, "slow-loris connection " + std::to_string(i));
     std::printf("slow-loris: %d of %d connections cut, after %.1f..%.1f s\n", cut.load(), kSlow,
@@ -151,7 +152,7 @@ TEST(FarmAttack, EveryAttackIsRefusedAndAcceptedWorkSurvives) {
   // 7. Random bytes as the body of every endpoint (with the right token), and as the request itself.
   {
     const BuildFingerprint& fp = build_fingerprint();
-    farm::HttpReply reg = worker_client.post_json(
+    client::HttpReply reg = worker_client.post_json(
         "/api/v1/workers", json{{"name", "fuzz"}, {"version", fp.version}, {"isa", fp.isa}, {"probe", fp.probe}});
     ASSERT_EQ(reg.status, 201) << reg.body;
     const std::string w = "/api/v1/workers/" + std::to_string(reg.json()["id"].get<uint64_t>());
@@ -196,16 +197,109 @@ TEST(FarmAttack, EveryAttackIsRefusedAndAcceptedWorkSurvives) {
   }
 
   // After: healthy; no job was created by any attack; B unchanged; A renders right once a worker joins.
-  EXPECT_TRUE(client.get("/healthz", 5).ok());
-  json jobs = client.get("/api/v1/jobs").json();
+  EXPECT_TRUE(http.get("/healthz", 5).ok());
+  json jobs = http.get("/api/v1/jobs").json();
   ASSERT_TRUE(jobs.is_object()) << "job list";
   EXPECT_EQ(jobs["jobs"].size(), 2u + flood.size()) << jobs.dump();
-  EXPECT_EQ(client.get("/api/v1/jobs/" + std::to_string(b) + "/image?format=exr").body, image_b);
+  EXPECT_EQ(http.get("/api/v1/jobs/" + std::to_string(b) + "/image?format=exr").body, image_b);
   farm.add_worker();
   ASSERT_EQ(farm.wait_job(a).value("state", ""), "done");
   EXPECT_EQ(differing_pixels(farm.image(a), local_render(cornell(), s)), 0);
   std::printf("attack suite: %d attacks, %d refused; server healthy, accepted jobs intact\n", tally.attacks, tally.refused);
   EXPECT_EQ(tally.refused, tally.attacks);
+}
+
+// No --max-unpacked, no --max-ratio: the defaults alone refuse a bundle that inflates 1000:1.
+TEST(FarmAttack, DefaultLimitsRefuseACompressionBomb) {
+  Farm farm({"--client-token", kClient, "--worker-token", kWorker});
+  farm.set_tokens(kClient, kWorker);
+  farm.start_server();
+  const client::FarmClient http = farm.client();
+  const std::string bomb = tgz("scene.xml", std::string(kXml) + std::string(200u << 20, ' '));
+  ASSERT_LT(bomb.size(), 300000u);
+  const client::HttpReply up = http.post_bytes("/api/v1/scenes", bomb, "application/gzip");
+  EXPECT_EQ(up.status, 400) << up.body;
+  EXPECT_NE(up.body.find("--max-ratio"), std::string::npos) << up.body;
+  const client::HttpReply job = client::FarmApi(http).submit_job(json::object(), bomb);
+  EXPECT_EQ(job.status, 400) << job.body;
+  EXPECT_EQ(http.post_bytes("/api/v1/scenes", tgz("scene.xml", kXml), "application/gzip").status, 201);
+  EXPECT_TRUE(http.get("/healthz", 5).ok());
+  std::printf("bomb under default limits: %zu bytes for %u unpacked: %d %s\n", bomb.size(), 200u << 20, up.status,
+              up.json().value("detail", "").c_str());
+}
+
+/// A request as curl writes it: `headers` verbatim ("Name: value\r\n" each), then the body.
+std::string curl_like(const std::string& method, const std::string& path, const std::string& headers,
+                      const std::string& body = "") {
+  return method + " " + path + " HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n" + headers + "\r\n" + body;
+}
+
+// What curl sends when a user types the docs' commands a little differently: the bearer scheme
+// in another case, POSTs without a body (no Content-Length), a bundle with curl's default
+// form Content-Type, and bodies over --max-upload. Each gets a proper answer at once.
+TEST(FarmAttack, HttpEdgeCasesAreAnsweredProperly) {
+  Farm farm({"--client-token", kClient, "--worker-token", kWorker, "--max-upload", "100000"});
+  farm.set_tokens(kClient, kWorker);
+  farm.start_server();
+  const int port = farm.port();
+  const std::string client_auth = "Authorization: Bearer " + std::string(kClient) + "\r\n";
+  const std::string worker_auth = "Authorization: Bearer " + std::string(kWorker) + "\r\n";
+
+  // The scheme is case-insensitive (RFC 7235); the token is not.
+  for (const std::string scheme : {"bearer", "BEARER", "bEaReR"})
+    EXPECT_EQ(raw_status(port, curl_like("GET", "/api/v1/jobs", "Authorization: " + scheme + " " + kClient + "\r\n")), 200)
+        << scheme;
+  const std::string client_token = kClient;
+  for (const std::string& wrong : std::vector<std::string>{"bearer guess", "bearer " + std::string(kWorker), "bearer",
+                                                           "bearer " + client_token.substr(1), "basic " + client_token})
+    EXPECT_EQ(raw_status(port, curl_like("GET", "/api/v1/jobs", "Authorization: " + wrong + "\r\n")), 401) << wrong;
+
+  // Bodiless POSTs (curl -X POST URL): answered by their handler, not after the read timeout.
+  const BuildFingerprint& fp = build_fingerprint();
+  const client::HttpReply reg = client::FarmClient(farm.url(), kWorker)
+                                    .post_json("/api/v1/workers", json{{"name", "edge"}, {"version", fp.version},
+                                                                       {"isa", fp.isa}, {"probe", fp.probe}});
+  ASSERT_EQ(reg.status, 201) << reg.body;
+  const std::string w = "/api/v1/workers/" + std::to_string(reg.json()["id"].get<uint64_t>());
+  EXPECT_EQ(raw_status(port, curl_like("POST", "/api/v1/jobs/999/retry", client_auth), 5), 404);
+  EXPECT_EQ(raw_status(port, curl_like("POST", w + "/lease?wait=1", worker_auth), 5), 204);
+  EXPECT_EQ(raw_status(port, curl_like("POST", w + "/drain", client_auth), 5), 200);
+  EXPECT_EQ(raw_status(port, curl_like("POST", w + "/lease?wait=1", worker_auth), 5), 410);
+
+  // curl --data-binary's default Content-Type is a form's; the bundle's bytes are taken as they are.
+  const std::string bundle = ArchiveBuilder(ArchiveBuilder::Format::TarGz).file("scene.xml", kXml).file("m.bin", noise(50000, 3)).finish();
+  const client::FarmClient http = farm.client();
+  const client::HttpReply as_form = http.post_bytes("/api/v1/scenes", bundle, "application/x-www-form-urlencoded");
+  EXPECT_EQ(as_form.status, 201) << as_form.body;
+  EXPECT_EQ(as_form.json().value("hash", ""), sha256_hex(bundle));
+
+  // Every 413 names the limit and its flag: a bundle over --max-upload (the coordinator's check)
+  // and a body over what the transport reads at all (cpp-httplib's); a chunked body, whose size
+  // the transport would not bound, is refused with 411.
+  const client::HttpReply big = http.post_bytes("/api/v1/scenes", noise(200000, 4), "application/gzip");
+  EXPECT_EQ(big.status, 413);
+  EXPECT_NE(big.body.find("--max-upload"), std::string::npos) << big.body;
+  const std::string body(17u << 20, 'x');
+  const std::string huge = raw_reply(
+      port, curl_like("POST", "/api/v1/scenes", client_auth + "Content-Length: " + std::to_string(body.size()) + "\r\n", body), 20);
+  EXPECT_EQ(status_of(huge), 413) << huge;
+  EXPECT_NE(huge.find("16877216 bytes (tessera-server --max-upload 100000"), std::string::npos) << huge;
+  EXPECT_EQ(raw_status(port, curl_like("POST", "/api/v1/scenes", client_auth + "Transfer-Encoding: chunked\r\n", "5\r\nhello\r\n0\r\n\r\n"), 5),
+            411);
+
+  // Heartbeats that are not an object with a lease list.
+  const client::FarmClient worker(farm.url(), kWorker);
+  for (const char* junk : {"[]", "42", "\"x\"", "null", "{\"leases\": \"x\"}", "{\"leases\": [1]}", "{\"junk\": 1}",
+                           "{\"leases\": [], \"junk\": 1}", "{\"leases\": [{\"id\": 1, \"job\": 1, \"tile\": 0}]}"})
+    EXPECT_EQ(worker.post_bytes(w + "/heartbeat", junk, "application/json").status, 400) << junk;
+  // 50 MB of junk in a heartbeat is refused before it is read (a message has at most 1 MiB).
+  const client::HttpReply junk_body = worker.post_bytes(w + "/heartbeat", std::string(50u << 20, ' '), "application/json", 20);
+  // (The connection is closed unread, so the client may see the reset before the answer.)
+  EXPECT_TRUE(junk_body.status == 413 || junk_body.status == 0) << junk_body.status << " " << junk_body.body;
+  if (junk_body.status == 413) {
+    EXPECT_NE(junk_body.body.find("at most 1048576"), std::string::npos) << junk_body.body;
+  }
+  EXPECT_TRUE(http.get("/healthz", 5).ok());
 }
 
 }  // namespace

@@ -18,7 +18,7 @@ struct Call {
   bool worker;  // needs the worker token (else the client token)
 };
 
-farm::HttpReply send(const farm::FarmClient& c, const Call& call) {
+client::HttpReply send(const client::FarmClient& c, const Call& call) {
   if (call.method == "GET") return c.get(call.path, 5);
   if (call.method == "DELETE") return c.del(call.path, json::object(), 5);
   return c.post_bytes(call.path, std::string(4096, 'x'), "application/octet-stream", 10);
@@ -39,15 +39,15 @@ TEST(FarmAuth, EveryCallNeedsTheRightToken) {
       {"POST", "/api/v1/workers/1/leases/1/fail", true}, {"DELETE", "/api/v1/workers/1", true},
       {"GET", "/api/v1/scenes/" + hash, true},        {"GET", "/metrics", false},
   };
-  const farm::FarmClient none(farm.url()), wrong(farm.url(), "guess"), client(farm.url(), kClient),
+  const client::FarmClient none(farm.url()), wrong(farm.url(), "guess"), client_side(farm.url(), kClient),
       worker(farm.url(), kWorker);
   int refused = 0;
   for (const Call& call : calls) {
     SCOPED_TRACE(call.method + " " + call.path);
-    const farm::FarmClient& other = call.worker ? client : worker;
-    for (const farm::FarmClient* c : {&none, &wrong, &other}) {
+    const client::FarmClient& other = call.worker ? client_side : worker;
+    for (const client::FarmClient* c : {&none, &wrong, &other}) {
       if (call.path.rfind("/api/v1/scenes/", 0) == 0 && c == &other) continue;  // either token may download
-      farm::HttpReply r = send(*c, call);
+      client::HttpReply r = send(*c, call);
       EXPECT_EQ(r.status, 401) << r.body;
       EXPECT_EQ(r.json().value("error", ""), "unauthorized");
       EXPECT_EQ(r.body.find("secret"), std::string::npos) << "the reply leaks a token";
@@ -55,13 +55,13 @@ TEST(FarmAuth, EveryCallNeedsTheRightToken) {
       refused += r.status == 401;
     }
     // The right token gets past the check (whatever the call itself then says).
-    EXPECT_NE(send(call.worker ? worker : client, call).status, 401);
+    EXPECT_NE(send(call.worker ? worker : client_side, call).status, 401);
   }
   std::printf("refused %d unauthorised calls\n", refused);
   EXPECT_TRUE(none.get("/healthz").ok()) << "health checks need no token";
   // The dashboard's page and files are open (they hold no data); what the page asks for is not.
   for (const char* path : {"/", "/ui/app.js", "/ui/style.css"}) {
-    farm::HttpReply page = none.get(path, 5);
+    client::HttpReply page = none.get(path, 5);
     EXPECT_EQ(page.status, 200) << path;
     EXPECT_FALSE(page.body.empty()) << path;
   }

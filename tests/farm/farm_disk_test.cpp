@@ -69,7 +69,7 @@ JobSettings job() {
   return s;
 }
 
-bool mentions(const farm::HttpReply& r, const std::string& text) { return r.body.find(text) != std::string::npos; }
+bool mentions(const client::HttpReply& r, const std::string& text) { return r.body.find(text) != std::string::npos; }
 
 std::string read_text(const std::string& path) {
   std::ifstream in(path);
@@ -89,7 +89,7 @@ TEST(FarmDisk, AFullDiskIsA507AndTheJobFinishesOnceSpaceIsFreed) {
   ASSERT_TRUE(disk.mounted()) << "mount -t tmpfs failed";
   farm.start_server();
   const JobSettings settings = job();
-  farm::HttpReply reply;
+  client::HttpReply reply;
   const uint64_t id = farm.submit(cornell(), settings, &reply);
   ASSERT_GT(id, 0u) << reply.describe();
 
@@ -105,7 +105,7 @@ TEST(FarmDisk, AFullDiskIsA507AndTheJobFinishesOnceSpaceIsFreed) {
   TempDir other;
   other.write("scene.xml", "<scene version=\"0.6.0\"><!-- another bundle --></scene>");
   const std::string bundle = pack_bundle(other.path.string(), {"scene.xml"});
-  farm::HttpReply up = farm.client().post_bytes("/api/v1/scenes", bundle, "application/gzip");
+  client::HttpReply up = farm.client().post_bytes("/api/v1/scenes", bundle, "application/gzip");
   EXPECT_EQ(up.status, 507) << up.describe();
   EXPECT_TRUE(mentions(up, "disk_full")) << up.body;
   EXPECT_TRUE(mentions(up, "the coordinator's disk is full")) << up.body;
@@ -127,10 +127,10 @@ TEST(FarmDisk, AFullDiskIsA507AndTheJobFinishesOnceSpaceIsFreed) {
   EXPECT_LT(st.value("units_done", 0), st.value("units_total", 0));
   EXPECT_GE(st.value("units_done", 0), 20) << "acknowledged passes stay acknowledged";
   const int units_on_full_disk = st.value("units_done", 0);
-  farm::HttpReply metrics = farm.client().get("/metrics");
+  client::HttpReply metrics = farm.client().get("/metrics");
   EXPECT_NE(metrics.body.find("tessera_disk_full_errors_total"), std::string::npos);
   // A submission with a new bundle on the full disk: 507 too, not a broken bundle (400).
-  farm::HttpReply sub = farm.client().post_job_with_bundle(nlohmann::json{{"spp", 1}}, bundle);
+  client::HttpReply sub = farm.api().submit_job(nlohmann::json{{"spp", 1}}, bundle);
   EXPECT_EQ(sub.status, 507) << sub.describe();
   EXPECT_TRUE(farm.client().get("/healthz").ok());
 
@@ -151,7 +151,7 @@ TEST(FarmDisk, AFullDiskIsA507AndTheJobFinishesOnceSpaceIsFreed) {
   ASSERT_GT(fill(filler), 0u);
   farm.start_server();
   EXPECT_EQ(farm.status(id).value("state", ""), "done");
-  farm::HttpReply image = farm.client().get("/api/v1/jobs/" + std::to_string(id) + "/image?format=exr", 60);
+  client::HttpReply image = farm.client().get("/api/v1/jobs/" + std::to_string(id) + "/image?format=exr", 60);
   EXPECT_TRUE(image.status == 507 || image.status == 200) << image.describe();
   std::printf("image after a restart on a full disk: %s\n", image.status == 200 ? "200" : image.describe().c_str());
   if (image.status == 200) {

@@ -6,7 +6,7 @@
 #include "tessera/farm/job_scene.h"
 #include "tessera/image/image.h"
 #include "tessera/render/renderer.h"
-#include "tessera/worker/farm_client.h"
+#include "tessera/client/farm_api.h"
 #include "test_support.h"
 
 #include <signal.h>
@@ -126,6 +126,7 @@ class Farm {
     FAIL() << "the server does not answer /healthz";
   }
   void kill_server() { server_.kill_now(); }
+  pid_t server_pid() const { return server_.pid(); }
   int stop_server() { return server_.terminate(); }
   /// Serve https with this certificate and key; the harness's client and workers verify against
   /// `ca_file` (the certificate itself, when self-signed).
@@ -168,19 +169,20 @@ class Farm {
   std::string url() const { return (ca_file_.empty() ? "http://" : "https://") + std::string("127.0.0.1:") + std::to_string(port_); }
   int port() const { return port_; }
   const std::string& ca_file() const { return ca_file_; }
-  farm::FarmClient client() const { return farm::FarmClient(url(), client_token_, ca_file_); }
+  client::FarmClient client() const { return client::FarmClient(url(), client_token_, ca_file_); }
+  client::FarmApi api() const { return client::FarmApi(client()); }
   const TempDir& dir() const { return dir_; }
   std::string log(const std::string& name) const { return (dir_.path / (name + ".log")).string(); }
 
   /// Submits `scene` (bundled as `tessera submit` does) with `settings`; returns the job id (0 on error).
-  uint64_t submit(const std::string& scene, JobSettings settings, farm::HttpReply* reply = nullptr) const {
+  uint64_t submit(const std::string& scene, JobSettings settings, client::HttpReply* reply = nullptr) const {
     auto abs = std::filesystem::absolute(scene);
     LoadedJobScene loaded = load_job_scene(abs.parent_path().string(), abs.filename().string(), settings, /*confine=*/false);
     BundlePlan plan = plan_bundle(abs.string(), scene_files(loaded.desc, loaded.loaded));
     settings.scene_file = plan.files.front();
     nlohmann::json body = to_json(settings);
     body.erase("scene");
-    farm::HttpReply r = client().post_job_with_bundle(body, pack_bundle(plan.root_dir, plan.files));
+    client::HttpReply r = api().submit_job(body, pack_bundle(plan.root_dir, plan.files));
     if (reply) *reply = r;
     return r.status == 201 ? r.json().value("id", uint64_t(0)) : 0;
   }
@@ -203,11 +205,11 @@ class Farm {
   nlohmann::json wait_job(uint64_t id, double seconds = 120) const {
     return wait_until(id, [](const nlohmann::json&) { return false; }, seconds);
   }
-  Image image(uint64_t id) const {
-    farm::HttpReply r = client().get("/api/v1/jobs/" + std::to_string(id) + "/image?format=exr", 60);
+  Image image(uint64_t id, ImageAttributes* attributes = nullptr) const {
+    client::HttpReply r = client().get("/api/v1/jobs/" + std::to_string(id) + "/image?format=exr", 60);
     std::string path = (dir_.path / ("job" + std::to_string(id) + ".exr")).string();
     std::ofstream(path, std::ios::binary) << r.body;
-    return read_exr(path);
+    return read_exr(path, attributes);
   }
 
  private:

@@ -44,7 +44,7 @@ TEST(FarmIntegration, TwoWorkersStitchTheImageBitForBit) {
   farm.add_worker();
   ASSERT_TRUE(farm.wait_workers(2));
   const JobSettings settings = small_job();
-  farm::HttpReply reply;
+  client::HttpReply reply;
   uint64_t id = farm.submit(cornell(), settings, &reply);
   ASSERT_GT(id, 0u) << reply.describe();
   nlohmann::json st = farm.wait_job(id);
@@ -60,34 +60,70 @@ TEST(FarmIntegration, TwoWorkersStitchTheImageBitForBit) {
   std::printf("shares: %s\n", st["workers"].dump().c_str());
 }
 
-TEST(FarmIntegration, KilledWorkerLeaseIsReissuedAndTheImageIsUnchanged) {
-  TESSERA_REQUIRE_FILE(cornell());
-  Farm farm({"--lease-timeout", "1.5"});
+// Two workers on the long job; worker 0 is killed (kill -9: its leases in flight are lost) once the
+// job is `at` done. Checks the finished image; returns the seconds until the coordinator saw the
+// worker `lost`.
+double kill_a_worker_at(double at) {
+  Farm farm({"--heartbeat-interval", "0.5"});
   farm.start_server();
   farm.add_worker();
   farm.add_worker();
-  ASSERT_TRUE(farm.wait_workers(2));
+  EXPECT_TRUE(farm.wait_workers(2));
   const JobSettings settings = long_job();
   uint64_t id = farm.submit(cornell(), settings);
-  ASSERT_GT(id, 0u);
-  nlohmann::json mid = farm.wait_until(id, [](const nlohmann::json& j) { return progress(j) > 0.2; });
-  ASSERT_EQ(mid.value("state", ""), "running") << "the job ended before the worker could be killed";
-  farm.worker(0).kill_now();  // kill -9: its leases in flight are lost
+  EXPECT_GT(id, 0u);
+  nlohmann::json before = farm.wait_until(id, [at](const nlohmann::json& j) { return progress(j) >= at; });
+  EXPECT_EQ(before.value("state", ""), "running") << "the job ended before the worker could be killed";
+  const auto killed = std::chrono::steady_clock::now();
+  farm.worker(0).kill_now();
+  std::string state;
+  while (state != "lost" && std::chrono::steady_clock::now() - killed < std::chrono::seconds(10)) {
+    const nlohmann::json workers = farm.client().get("/api/v1/workers").json();
+    for (const auto& w : workers["workers"])
+      if (w["name"] == "w0") state = w["state"];
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  const double noticed = std::chrono::duration<double>(std::chrono::steady_clock::now() - killed).count();
+  EXPECT_EQ(state, "lost");
   nlohmann::json st = farm.wait_job(id);
-  ASSERT_EQ(st.value("state", ""), "done") << st.dump(2);
+  EXPECT_EQ(st.value("state", ""), "done") << st.dump(2);
+  const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - killed).count();
   EXPECT_EQ(differing_pixels(farm.image(id), local_render(cornell(), settings)), 0);
-  std::printf("killed worker at %.0f%%; leases issued %d for %d units\n", 100 * progress(mid),
-              st.value("leases_issued", 0), st.value("units_total", 0));
+  EXPECT_EQ(st.value("mismatched_results", -1), 0);
+  std::printf("killed a worker at %.0f%%: seen lost after %.2f s, job done %.2f s after the kill; %d leases for %d units\n",
+              100 * progress(before), noticed, total, st.value("leases_issued", 0), st.value("units_total", 0));
+  return state == "lost" ? noticed : -1;
+}
+
+TEST(FarmIntegration, KilledWorkerLeaseIsReissuedAndTheImageIsUnchanged) {
+  TESSERA_REQUIRE_FILE(cornell());
+  EXPECT_GE(kill_a_worker_at(0.2), 0);
+}
+
+// Near the end: the dead worker is noticed within 3 heartbeat intervals (not a long lease timeout),
+// and its last units go to the worker left (speculative copies may take them even sooner).
+TEST(FarmIntegration, KilledWorkerNearTheEndIsReplacedWithinTheHeartbeatBound) {
+  TESSERA_REQUIRE_FILE(cornell());
+  const double noticed = kill_a_worker_at(0.9);
+  EXPECT_GE(noticed, 0);
+  EXPECT_LT(noticed, 3 * 0.5 + 4.0) << "3 heartbeat intervals, plus the reaper's tick and slack for a busy machine";
 }
 
 TEST(FarmIntegration, KilledCoordinatorResumesWithoutRerenderingAcknowledgedPasses) {
   TESSERA_REQUIRE_FILE(cornell());
-  Farm farm;
+  // Without speculative copies every duplicate would be a unit rendered twice for the restart.
+  Farm farm({"--no-speculation"});
   farm.start_server();
   farm.add_worker();
   farm.add_worker();
   ASSERT_TRUE(farm.wait_workers(2));
-  const JobSettings settings = long_job();
+  // Few, slow units (up to 64 samples of 96x96 pixels each): the coordinator is killed while both
+  // workers are inside one, so their leases are in flight across the restart.
+  JobSettings settings = long_job();
+  settings.spp = 320;
+  settings.width = 192;
+  settings.height = 96;
+  settings.tile_size = 96;
   uint64_t id = farm.submit(cornell(), settings);
   ASSERT_GT(id, 0u);
   nlohmann::json mid = farm.wait_until(id, [](const nlohmann::json& j) { return progress(j) > 0.3; });
@@ -101,6 +137,7 @@ TEST(FarmIntegration, KilledCoordinatorResumesWithoutRerenderingAcknowledgedPass
   nlohmann::json st = farm.wait_job(id);
   ASSERT_EQ(st.value("state", ""), "done") << st.dump(2);
   EXPECT_EQ(st.value("reissued_acknowledged_passes", -1), 0);
+  EXPECT_EQ(st.value("duplicate_results", -1), 0) << "leases in flight were re-issued instead of re-adopted";
   EXPECT_EQ(differing_pixels(farm.image(id), local_render(cornell(), settings)), 0);
   std::printf("coordinator killed at %d/%d units; after restart %d; leases issued %d, re-issued after ack %d\n",
               mid.value("units_done", 0), mid.value("units_total", 0), resumed.value("units_done", 0),
@@ -127,7 +164,7 @@ TEST(FarmIntegration, HigherPriorityJobOvertakesAndCancelStopsAJob) {
   nlohmann::json low_st = farm.status(low_id);
   EXPECT_EQ(low_st.value("state", ""), "running") << "the high-priority job should finish first";
 
-  farm::HttpReply r = farm.client().del("/api/v1/jobs/" + std::to_string(low_id));
+  client::HttpReply r = farm.client().del("/api/v1/jobs/" + std::to_string(low_id));
   EXPECT_EQ(r.status, 200) << r.describe();
   nlohmann::json cancelled = farm.wait_job(low_id, 10);
   EXPECT_EQ(cancelled.value("state", ""), "cancelled");
@@ -187,7 +224,7 @@ TEST(FarmIntegration, DrainedWorkerSignsOffAndExits) {
   farm.start_server();
   farm.add_worker();
   ASSERT_TRUE(farm.wait_workers(1));
-  farm::HttpReply r = farm.client().post_json("/api/v1/workers/1/drain", nlohmann::json::object());
+  client::HttpReply r = farm.client().post_json("/api/v1/workers/1/drain", nlohmann::json::object());
   ASSERT_EQ(r.status, 200) << r.describe();
   EXPECT_EQ(farm.worker(0).wait_exit(20), 0);
   nlohmann::json workers = farm.client().get("/api/v1/workers").json();
@@ -197,8 +234,8 @@ TEST(FarmIntegration, DrainedWorkerSignsOffAndExits) {
 TEST(FarmIntegration, HeartbeatsKeepLongTilesLeased) {
   TESSERA_REQUIRE_FILE(cornell());
   // One 128x96 tile; its 64-sample pass takes seconds on one thread, longer than the 1.5 s lease
-  // timeout: only the heartbeats keep it from being re-issued.
-  Farm farm({"--lease-timeout", "1.5"});
+  // timeout (3 heartbeat intervals of 0.5 s): only the heartbeats keep it from being re-issued.
+  Farm farm({"--heartbeat-interval", "0.5"});
   farm.start_server();
   farm.add_worker();
   ASSERT_TRUE(farm.wait_workers(1));

@@ -15,7 +15,7 @@ std::string cornell() { return shared_path("scenes/cornell-box/scene.xml"); }
 std::string animation() { return std::string(TESSERA_SOURCE_DIR) + "/scenes/animation/scene.xml"; }
 
 // Posts settings + the scene's bundle (as tessera submit does), with extra fields merged in.
-farm::HttpReply post_job(const Farm& farm, const std::string& scene, JobSettings settings, const json& extra) {
+client::HttpReply post_job(const Farm& farm, const std::string& scene, JobSettings settings, const json& extra) {
   auto abs = std::filesystem::absolute(scene);
   LoadedJobScene loaded = load_job_scene(abs.parent_path().string(), abs.filename().string(), settings, false);
   BundlePlan plan = plan_bundle(abs.string(), scene_files(loaded.desc, loaded.loaded));
@@ -23,7 +23,7 @@ farm::HttpReply post_job(const Farm& farm, const std::string& scene, JobSettings
   json body = to_json(settings);
   body.erase("scene");
   body.update(extra);
-  return farm.client().post_job_with_bundle(body, pack_bundle(plan.root_dir, plan.files));
+  return farm.api().submit_job(body, pack_bundle(plan.root_dir, plan.files));
 }
 
 double rel_mse(const Image& x, const Image& ref) {
@@ -63,8 +63,10 @@ TEST(FarmOps, JobStopsAtItsTargetNoiseAtAPassBoundary) {
   JobSettings reached = s;
   reached.spp = spp;
   reached.target_error = 0;
-  const Image image = farm.image(id);
+  ImageAttributes header;
+  const Image image = farm.image(id, &header);
   EXPECT_EQ(differing_pixels(image, local_render(cornell(), reached)), 0);
+  EXPECT_EQ(header["tessera_spp"], std::to_string(spp)) << "the EXR header names the spp reached, not the budget";
   // And `tessera render --target-error` with the same budget stops at the same pass.
   EXPECT_EQ(differing_pixels(image, local_render(cornell(), s)), 0);
   // And the estimate is an estimate of the truth (printed, judged by people: issue 7 measures it).
@@ -131,7 +133,7 @@ TEST(FarmOps, WebhooksAreCalledWhenJobsEnd) {
   s.height = 24;
   s.webhook = url;
   // Refused before anything runs: a webhook outside the allowed prefixes.
-  farm::HttpReply refused;
+  client::HttpReply refused;
   JobSettings elsewhere = s;
   elsewhere.webhook = "http://169.254.169.254/latest";
   EXPECT_EQ(farm.submit(cornell(), elsewhere, &refused), 0u);
@@ -163,7 +165,7 @@ TEST(FarmOps, FrameRangesRenderOneJobPerFrame) {
   s.spp = 4;
   s.width = 48;
   s.height = 36;
-  farm::HttpReply r = post_job(farm, animation(), s, json{{"frames", "1-3"}, {"name", "roll"}});
+  client::HttpReply r = post_job(farm, animation(), s, json{{"frames", "1-3"}, {"name", "roll"}});
   ASSERT_EQ(r.status, 201) << r.body;
   json jobs = r.json()["jobs"];
   ASSERT_EQ(jobs.size(), 3u);
@@ -180,7 +182,7 @@ TEST(FarmOps, FrameRangesRenderOneJobPerFrame) {
   EXPECT_GT(differing_pixels(images[0], images[2]), 0) << "the frames differ";
   // Bad ranges are refused whole.
   for (const json& bad : {json("3-1"), json("x"), json("1-100000"), json::array({1})}) {
-    farm::HttpReply b = post_job(farm, animation(), s, json{{"frames", bad}});
+    client::HttpReply b = post_job(farm, animation(), s, json{{"frames", bad}});
     EXPECT_EQ(b.status, 400) << bad.dump() << " " << b.body;
   }
 }

@@ -33,9 +33,9 @@ TEST(FarmTls, WorkersAndClientsVerifyTheServer) {
 
   // Plain http to the https port gets no HTTP answer; https without the right CA is refused.
   const std::string host = "127.0.0.1:" + std::to_string(farm.port());
-  EXPECT_EQ(farm::FarmClient("http://" + host, "c-tls").get("/healthz", 5).status, 0);
-  EXPECT_EQ(farm::FarmClient("https://" + host, "c-tls").get("/healthz", 5).status, 0) << "verified against system CAs";
-  farm::HttpReply wrong_ca = farm::FarmClient("https://" + host, "c-tls", (farm.dir().path / "other.pem").string()).get("/healthz", 5);
+  EXPECT_EQ(client::FarmClient("http://" + host, "c-tls").get("/healthz", 5).status, 0);
+  EXPECT_EQ(client::FarmClient("https://" + host, "c-tls").get("/healthz", 5).status, 0) << "verified against system CAs";
+  client::HttpReply wrong_ca = client::FarmClient("https://" + host, "c-tls", (farm.dir().path / "other.pem").string()).get("/healthz", 5);
   EXPECT_EQ(wrong_ca.status, 0);
   std::printf("wrong CA: %s\n", wrong_ca.describe().c_str());
 

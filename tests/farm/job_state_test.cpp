@@ -36,6 +36,8 @@ TEST(JobState, OutOfOrderDuplicatedPassesStitchToTheLocalRender) {
   plan.full_width = scene.film.width;
   plan.full_height = scene.film.height;
   JobState job(1, plan, "test", 0, 0);
+  EXPECT_FALSE(job.film_allocated()) << "a queued job holds no film";
+  EXPECT_EQ(job.image().width(), 29) << "its image is black until results arrive";
   ASSERT_EQ(job.num_passes(), 4u);
   ASSERT_EQ(job.num_tiles(), 4u * 3u);
 
@@ -58,6 +60,7 @@ TEST(JobState, OutOfOrderDuplicatedPassesStitchToTheLocalRender) {
     FilmTile tile;
     render_tile(scene, job.rect(u), job.sample_begin(u), job.sample_end(u), plan.settings.seed, tile);
     duplicates += !job.add_result(u, std::move(tile), u % 3);
+    EXPECT_TRUE(job.film_allocated());
   }
   EXPECT_EQ(duplicates, 2);
   EXPECT_EQ(job.duplicates, 2u);

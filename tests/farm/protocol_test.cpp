@@ -118,5 +118,32 @@ TEST(Protocol, LeaseRoundTripAndCacheKey) {
   EXPECT_NE(scene_cache_key(a, "s.xml"), scene_cache_key(a, "t.xml"));
 }
 
+TEST(Protocol, HeartbeatsRoundTripAndAreStrict) {
+  const std::vector<HeldLease> held = {{31, 1, 5, 2}, {32, 1, 6, 2}};
+  std::vector<HeldLease> back;
+  std::string error;
+  ASSERT_TRUE(heartbeat_from_json(heartbeat_to_json(held), back, error)) << error;
+  ASSERT_EQ(back.size(), 2u);
+  EXPECT_EQ(back[1].id, 32u);
+  EXPECT_EQ(back[1].tile, 6u);
+  ASSERT_TRUE(heartbeat_from_json(json::object(), back, error)) << "no leases held";
+  EXPECT_TRUE(back.empty());
+  auto refused = [&](const json& j, const std::string& why) {
+    std::string e;
+    std::vector<HeldLease> out;
+    EXPECT_FALSE(heartbeat_from_json(j, out, e)) << j.dump().substr(0, 80);
+    EXPECT_NE(e.find(why), std::string::npos) << e;
+  };
+  refused(json::array(), "expected a JSON object");
+  refused(json{{"leases", json::array()}, {"junk", 1}}, "unknown field 'junk'");
+  refused(json{{"leases", "x"}}, "'leases' must be an array");
+  refused(json{{"leases", {{{"id", 1}, {"job", 1}, {"tile", 0}}}}}, "missing field 'pass'");
+  refused(json{{"leases", {{{"id", -1}, {"job", 1}, {"tile", 0}, {"pass", 0}}}}}, "field 'id'");
+  refused(json{{"leases", {{{"id", 1}, {"job", 1}, {"tile", 0}, {"pass", 0}, {"extra", 0}}}}}, "unknown field 'extra'");
+  json many = json::array();
+  for (size_t i = 0; i <= kMaxHeldLeases; ++i) many.push_back({{"id", i}, {"job", 1}, {"tile", 0}, {"pass", 0}});
+  refused(json{{"leases", many}}, "at most");
+}
+
 }  // namespace
 }  // namespace tessera

@@ -61,16 +61,32 @@ class RawConnection {
   bool connected_ = false;
 };
 
+/// Sends `request` on a fresh connection and returns everything the server sent before closing
+/// it, or within `seconds`.
+inline std::string raw_reply(int port, const std::string& request, double seconds = 10) {
+  RawConnection c(port);
+  if (!c.connected()) return "";
+  c.send(request);
+  std::string reply;
+  c.closed_within(seconds, &reply);
+  return reply;
+}
+
+/// The HTTP status of a raw reply (0: none, the server just closed).
+inline int status_of(const std::string& reply) {
+  if (reply.rfind("HTTP/1.", 0) != 0 || reply.size() < 12) return 0;
+  return std::atoi(reply.c_str() + 9);
+}
+
 /// Sends `request` on a fresh connection and returns the HTTP status of the reply (0: none, the
-/// server just closed), waiting at most `seconds`.
+/// server just closed; -1: no connection), waiting at most `seconds`.
 inline int raw_status(int port, const std::string& request, double seconds = 10) {
   RawConnection c(port);
   if (!c.connected()) return -1;
   c.send(request);
   std::string reply;
   c.closed_within(seconds, &reply);
-  if (reply.rfind("HTTP/1.", 0) != 0 || reply.size() < 12) return 0;
-  return std::atoi(reply.c_str() + 9);
+  return status_of(reply);
 }
 
 inline std::string raw_request(const std::string& method, const std::string& path, const std::string& token,

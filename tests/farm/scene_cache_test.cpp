@@ -32,7 +32,7 @@ constexpr const char* kXml = "<scene version=\"0.6.0\"><shape type=\"sphere\"/>"
 
 TEST(SceneCache, LoadsOnceAndEvictsLeastRecentlyUsed) {
   TempDir dir;
-  farm::FarmClient nowhere("http://127.0.0.1:9");  // never contacted: bundles are in the cache
+  const client::FarmApi nowhere(client::FarmClient("http://127.0.0.1:9"));  // never contacted: bundles are in the cache
   Lease a = cached_lease(dir, kXml, 8), b = a, c = a;
   b.settings.width = 9;
   c.settings.width = 10;
@@ -60,7 +60,7 @@ TEST(SceneCache, LoadsOnceAndEvictsLeastRecentlyUsed) {
 
 TEST(SceneCache, FailuresAreReportedAndNotCached) {
   TempDir dir;
-  farm::FarmClient nowhere("http://127.0.0.1:9");
+  const client::FarmApi nowhere(client::FarmClient("http://127.0.0.1:9"));
   Lease bad = cached_lease(dir, "<scene version=\"0.6.0\"><shape type=\"obj\"><string name=\"filename\" "
                                 "value=\"missing.obj\"/></shape></scene>", 8);
   farm::SceneCache cache(dir.path.string(), uint64_t(1) << 30);

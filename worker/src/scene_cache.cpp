@@ -21,12 +21,12 @@ SceneCache::SceneCache(std::string cache_dir, uint64_t budget) : dir_(std::move(
   fs::create_directories(fs::path(dir_) / "scenes");
 }
 
-std::string SceneCache::bundle_file(const Lease& lease, const FarmClient& client) {
+std::string SceneCache::bundle_file(const Lease& lease, const client::FarmApi& api) {
   const std::string& hash = lease.settings.scene;
   const fs::path path = fs::path(dir_) / "bundles" / (hash + ".bundle");
   std::lock_guard<std::mutex> lock(download_mutex_);
   if (fs::exists(path)) return path.string();
-  HttpReply r = client.get("/api/v1/scenes/" + hash, 600);
+  client::HttpReply r = api.download_scene(hash);
   if (!r.ok()) throw std::runtime_error("cannot download scene bundle " + hash + ": " + r.describe());
   if (sha256_hex(r.body) != hash) throw std::runtime_error("scene bundle " + hash + " arrived corrupt (hash mismatch)");
   const fs::path tmp = path.string() + ".tmp" + std::to_string(std::random_device{}());
@@ -37,8 +37,8 @@ std::string SceneCache::bundle_file(const Lease& lease, const FarmClient& client
   return path.string();
 }
 
-std::shared_ptr<const CachedScene> SceneCache::load(const Lease& lease, const FarmClient& client) {
-  const std::string bundle = bundle_file(lease, client);
+std::shared_ptr<const CachedScene> SceneCache::load(const Lease& lease, const client::FarmApi& api) {
+  const std::string bundle = bundle_file(lease, api);
   // Only what the scene references is unpacked; the directory is keyed by that list, so two jobs
   // that use different parts of one bundle do not disturb each other.
   std::string files_key;
@@ -50,7 +50,11 @@ std::shared_ptr<const CachedScene> SceneCache::load(const Lease& lease, const Fa
       std::ifstream in(bundle, std::ios::binary);
       std::ostringstream ss;
       ss << in.rdbuf();
-      BundleResult r = unpack_bundle(ss.str(), dir.string(), BundleLimits{},
+      // The coordinator checked the bundle's compression ratio against its own --max-ratio (which
+      // its operator may have raised for a scene): refusing here what it accepted would fail the job.
+      BundleLimits limits;
+      limits.max_ratio = 0;
+      BundleResult r = unpack_bundle(ss.str(), dir.string(), limits,
                                      std::set<std::string>(lease.files.begin(), lease.files.end()));
       if (!r.ok()) throw std::runtime_error("scene bundle " + lease.settings.scene.substr(0, 12) + ": " + r.error);
     }
@@ -62,7 +66,7 @@ std::shared_ptr<const CachedScene> SceneCache::load(const Lease& lease, const Fa
   return out;
 }
 
-std::shared_ptr<const CachedScene> SceneCache::get(const Lease& lease, const FarmClient& client) {
+std::shared_ptr<const CachedScene> SceneCache::get(const Lease& lease, const client::FarmApi& api) {
   const std::string key = scene_cache_key(lease.settings, lease.scene_file);
   std::promise<std::shared_ptr<const CachedScene>> promise;
   std::shared_future<std::shared_ptr<const CachedScene>> future;
@@ -82,7 +86,7 @@ std::shared_ptr<const CachedScene> SceneCache::get(const Lease& lease, const Far
   }
   if (loader) {
     try {
-      promise.set_value(load(lease, client));
+      promise.set_value(load(lease, api));
     } catch (...) {
       // A failed load is not cached: the next lease tries again (the bundle may have been fixed).
       promise.set_exception(std::current_exception());

@@ -37,7 +37,7 @@ WorkerOptions resolve_worker_options(WorkerOptions o) {
 }
 
 Worker::Worker(WorkerOptions options)
-    : opt_(resolve_worker_options(std::move(options))), client_(opt_.server, opt_.token, opt_.ca_file), cache_(opt_.cache_dir, opt_.memory_budget) {}
+    : opt_(resolve_worker_options(std::move(options))), api_(client::FarmClient(opt_.server, opt_.token, opt_.ca_file)), cache_(opt_.cache_dir, opt_.memory_budget) {}
 
 void Worker::backoff(int& attempt, bool interruptible) {
   // 0.25 s doubling to 8 s, in small steps so a stop request is seen at once.
@@ -51,16 +51,15 @@ bool Worker::register_with_server() {
   const BuildFingerprint& fp = build_fingerprint();
   WorkerHello hello{opt_.name, opt_.threads, opt_.memory_budget, fp.version, fp.isa, fp.probe};
   for (int attempt = 0; !stop_;) {
-    HttpReply r = client_.post_json("/api/v1/workers", to_json(hello), 30);
-    if (r.status == 201 || r.status == 200) {
-      json j = r.json();
-      worker_id_ = j.value("id", uint64_t(0));
-      heartbeat_seconds_ = j.value("heartbeat_seconds", 5.0);
+    client::ApiReply<client::Registration> r = api_.register_worker(hello);
+    if (r.ok()) {
+      worker_id_ = r.value.id;
+      heartbeat_seconds_ = r.value.heartbeat_seconds;
       spdlog::info("worker '{}' registered with {} as worker {} ({} threads)", opt_.name, opt_.server,
                    worker_id_.load(), opt_.threads);
       return true;
     }
-    if (r.status == 409 || r.status == 400 || r.status == 401) {
+    if (r.http.status == 409 || r.http.status == 400 || r.http.status == 401) {
       spdlog::error("the coordinator refused this worker: {}", r.describe());
       refused_ = true;
       stop_ = true;
@@ -74,7 +73,7 @@ bool Worker::register_with_server() {
 
 int Worker::run() {
   std::string why;
-  if (!client_.valid(&why)) {
+  if (!api_.valid(&why)) {
     spdlog::error("{}", why);
     return 2;
   }
@@ -94,7 +93,7 @@ int Worker::run() {
   slots_done = true;
   heartbeat.join();
   // Sign off: the coordinator re-issues anything still leased to us at once.
-  HttpReply r = client_.del("/api/v1/workers/" + std::to_string(worker_id_.load()), json::object(), 10);
+  client::HttpReply r = api_.sign_off(worker_id_.load());
   spdlog::info("worker {} signed off ({}): {} passes rendered, {} uploaded, {} duplicates, {} failures",
                worker_id_.load(), r.ok() ? "ok" : r.describe(), stats_.passes_rendered.load(),
                stats_.passes_uploaded.load(), stats_.duplicates.load(), stats_.failures.load());
@@ -102,23 +101,21 @@ int Worker::run() {
 }
 
 void Worker::heartbeat_loop() {
-  json leases = json::array();
+  std::vector<HeldLease> held;
   {
     std::lock_guard<std::mutex> lock(leases_mutex_);
-    for (auto& [id, l] : active_) leases.push_back({{"id", id}, {"job", l.job_id}, {"tile", l.tile}, {"pass", l.pass}});
+    for (auto& [id, l] : active_) held.push_back({id, l.job_id, l.tile, l.pass});
   }
   const uint64_t id = worker_id_;
-  HttpReply r = client_.post_json("/api/v1/workers/" + std::to_string(id) + "/heartbeat", json{{"leases", leases}}, 10);
-  if (r.status == 404) {
+  client::ApiReply<std::vector<uint64_t>> r = api_.heartbeat(id, held);
+  if (r.http.status == 404) {
     std::lock_guard<std::mutex> lock(register_mutex_);
     if (worker_id_ == id) register_with_server();
     return;
   }
-  json j = r.json();
-  if (!r.ok() || !j.is_object() || !j.contains("drop")) return;
+  if (!r.ok()) return;
   std::lock_guard<std::mutex> lock(leases_mutex_);
-  for (const json& d : j["drop"])
-    if (d.is_number_unsigned()) dropped_[d.get<uint64_t>()] = true;
+  for (uint64_t d : r.value) dropped_[d] = true;
 }
 
 void Worker::slot_loop(int slot) {
@@ -127,41 +124,37 @@ void Worker::slot_loop(int slot) {
     if (opt_.max_leases > 0 && leases_taken_ >= opt_.max_leases) break;
     const uint64_t id = worker_id_;
     const auto t0 = Clock::now();
-    HttpReply r = client_.post_json("/api/v1/workers/" + std::to_string(id) + "/lease?wait=" +
-                                        std::to_string(opt_.poll_wait),
-                                    json::object(), opt_.poll_wait + 15);
-    if (r.status == 404) {
+    client::ApiReply<std::optional<Lease>> r = api_.lease(id, opt_.poll_wait, opt_.poll_wait + 15);
+    if (r.http.status == 404) {
       std::lock_guard<std::mutex> lock(register_mutex_);
       if (worker_id_ == id) register_with_server();
       continue;
     }
-    if (r.status == 410) {  // drained by an operator: finish, sign off, exit
+    if (r.http.status == 410) {  // drained by an operator: finish, sign off, exit
       spdlog::info("slot {}: the coordinator drains this worker: {}", slot, r.describe());
       stop_ = true;
       break;
     }
-    if (r.status == 204) {
+    if (r.ok() && !r.value) {
       attempt = 0;
       // Answered at once (the coordinator's long-poll slots are full): wait as told.
       if (Clock::now() - t0 < std::chrono::milliseconds(500)) backoff(attempt);
       attempt = 0;
       continue;
     }
-    if (r.status != 200) {
+    if (!r.error.empty()) {
+      spdlog::error("slot {}: {}", slot, r.error);
+      continue;
+    }
+    if (!r.ok()) {
       if (attempt == 0) spdlog::warn("slot {}: lease request failed: {}; retrying", slot, r.describe());
       backoff(attempt);
       continue;
     }
     attempt = 0;
-    Lease lease;
-    std::string error;
-    if (!lease_from_json(r.json(), lease, error)) {
-      spdlog::error("slot {}: bad lease from the coordinator: {}", slot, error);
-      continue;
-    }
     if (stop_) break;  // sign-off hands it back
     ++leases_taken_;
-    process(lease);
+    process(*r.value);
   }
 }
 
@@ -179,14 +172,12 @@ void Worker::process(const Lease& lease) {
   };
   std::shared_ptr<const CachedScene> scene;
   try {
-    scene = cache_.get(lease, client_);
+    scene = cache_.get(lease, api_);
   } catch (const std::exception& e) {
     finish();
     ++stats_.failures;
     spdlog::error("job {}: cannot load the scene: {}", lease.job_id, e.what());
-    (void)client_.post_json("/api/v1/workers/" + std::to_string(worker_id_.load()) + "/leases/" +
-                                std::to_string(lease.id) + "/fail",
-                            json{{"error", e.what()}}, 10);
+    (void)api_.fail_lease(worker_id_.load(), lease.id, e.what());
     return;
   }
   TileResult result = render_lease(*scene->scene, lease);
@@ -202,19 +193,17 @@ bool Worker::upload(const Lease& lease, const std::string& bytes) {
   int attempt = 0;
   while (Clock::now() < give_up) {
     const uint64_t id = worker_id_;
-    HttpReply r = client_.post_bytes("/api/v1/workers/" + std::to_string(id) + "/results?lease=" +
-                                         std::to_string(lease.id),
-                                     bytes, "application/x-tessera-tile", 60);
+    client::ApiReply<client::ResultAck> r = api_.upload_result(id, lease.id, bytes);
     if (r.ok()) {
-      if (r.json().value("duplicate", false)) ++stats_.duplicates;
+      if (r.value.duplicate) ++stats_.duplicates;
       return true;
     }
-    if (r.status == 404 && r.json().value("error", "") == "unknown_worker") {
+    if (r.http.status == 404 && r.http.json().value("error", "") == "unknown_worker") {
       std::lock_guard<std::mutex> lock(register_mutex_);
       if (worker_id_ == id && !register_with_server()) return false;
       continue;
     }
-    if (r.status >= 400 && r.status < 500) {
+    if (r.http.status >= 400 && r.http.status < 500) {
       // Refused for good (job cancelled, unit no longer exists): nothing to retry.
       spdlog::info("job {} tile {} pass {}: result not taken: {}", lease.job_id, lease.tile, lease.pass, r.describe());
       return false;

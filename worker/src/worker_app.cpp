@@ -1,12 +1,15 @@
 #include "tessera/worker/worker_app.h"
 
+#include "tessera/farm/build_fingerprint.h"
 #include "tessera/worker/worker.h"
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
 #include <signal.h>
 
+#include <cstdio>
 #include <thread>
 
 namespace tessera::farm {
@@ -26,6 +29,16 @@ int worker_main(int argc, char** argv) {
   app.add_option("--max-leases", o.max_leases, "exit after this many leases (benchmarks)");
   std::string token_file;
   app.add_option("--token-file", token_file, "read the worker token from this file (else $TESSERA_WORKER_TOKEN)");
+  // What registration sends about this build, for scripts and docs/api.md's curl examples: a
+  // coordinator accepts only workers whose fingerprint matches its own.
+  app.add_flag_callback(
+      "--fingerprint",
+      [] {
+        const BuildFingerprint& fp = build_fingerprint();
+        std::printf("%s\n", nlohmann::json{{"version", fp.version}, {"isa", fp.isa}, {"probe", fp.probe}}.dump().c_str());
+        throw CLI::Success();
+      },
+      "print this build's fingerprint (version, isa, probe) as JSON and exit");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -23,6 +23,9 @@ struct AuthTokens {
 /// accepts. A role without a configured token accepts anything.
 bool authorized(const AuthTokens& tokens, Access access, const std::string& authorization);
 
+/// The token of an `Authorization: Bearer TOKEN` header (scheme in any case), or "" for any other.
+std::string bearer_token(const std::string& authorization);
+
 /// Constant-time equality (on SHA-256 digests of both strings).
 bool tokens_equal(const std::string& a, const std::string& b);
 

@@ -22,9 +22,16 @@ namespace tessera::server {
 
 struct CoordinatorOptions {
   std::string data_dir = "tessera-data";
-  double lease_timeout = 30;      // seconds without a heartbeat before a lease is re-issued
+  // Workers heartbeat this often (seconds). One silent for 3 intervals (kMissedHeartbeats) is
+  // declared dead and its leases are re-issued at once; a lease its worker stops reporting expires
+  // after the same time; after a restart, the leases of the previous process are held that long
+  // for their workers to re-adopt them.
+  double heartbeat_interval = 2;
   double max_poll_wait = 30;      // upper bound of a lease long poll
   int max_waiting_polls = 16;     // concurrent long polls; more get 204 at once (never starve clients)
+  // Idle workers get a copy of a job's oldest outstanding unit once it has no unleased one
+  // (scheduler.h); the first result wins and a later one must match it bit for bit.
+  bool speculate = true;
   int worker_failure_limit = 2;   // failures of one worker on one job before it is kept off the job
   int failed_workers_limit = 3;   // distinct workers failing a job before the job fails
   JobLimits limits;
@@ -40,6 +47,10 @@ struct CoordinatorOptions {
   // Seconds between retention passes (which also retry images a full disk kept from being
   // written); the first runs at start-up. 0: only on apply_retention().
   double maintenance_interval = 60;
+  // A program that plans a job's scene in a child process (`PROGRAM --plan-scene`, i.e.
+  // tessera-server itself), so the memory of loading it goes back to the system; empty: in this
+  // process (tests).
+  std::string scene_planner;
   std::vector<std::string> webhook_allow;  // URL prefixes a job's webhook must start with; empty: any  // queued + running; more are refused with 429 until some end
 };
 
@@ -82,7 +93,9 @@ class Coordinator {
   Result<nlohmann::json> register_worker(const nlohmann::json& hello);
   /// Waits up to `wait_seconds` (bounded by max_poll_wait) for work. A null json: nothing to do.
   Result<nlohmann::json> lease(uint64_t worker, double wait_seconds);
-  Result<nlohmann::json> heartbeat(uint64_t worker, const nlohmann::json& body);
+  /// The leases the worker still holds: each is kept alive (or re-adopted after a restart); the
+  /// answer's "drop" lists those the coordinator no longer wants.
+  Result<nlohmann::json> heartbeat(uint64_t worker, const std::vector<HeldLease>& held);
   /// A tile result (tile_result.h bytes). Accepted once per unit: a duplicate is acknowledged and
   /// dropped. Valid without a live lease too (a worker finishing across a coordinator restart).
   Result<nlohmann::json> upload_result(uint64_t worker, uint64_t lease, std::string_view bytes);

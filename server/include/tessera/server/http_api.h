@@ -5,6 +5,8 @@
 #include "tessera/server/auth.h"
 #include "tessera/server/coordinator.h"
 
+#include <cstdint>
+
 namespace httplib {
 class Server;
 }
@@ -13,10 +15,12 @@ namespace tessera::server {
 
 class ConnectionGuard;
 
-/// Installs every /api/v1 route, /healthz, the bearer-token check (before any body is read) and
-/// JSON error and exception handlers. With a guard, every request is reported to it (the
-/// slow-loris watch) and, at debug level, logged as an "http.request" event.
-void install_routes(httplib::Server& http, Coordinator& coordinator, const AuthTokens& tokens = {},
-                    ConnectionGuard* guard = nullptr);
+/// Installs every /api/v1 route, /healthz, the checks made before any body is read (bearer
+/// token, body framing) and JSON error and exception handlers. Bodies are read up to
+/// `max_upload_bytes` (--max-upload) plus 16 MiB for a form's other fields; a longer one is
+/// discarded and refused (413). With a guard, every request is reported to it (the slow-loris
+/// watch) and, at debug level, logged as an "http.request" event.
+void install_routes(httplib::Server& http, Coordinator& coordinator, uint64_t max_upload_bytes,
+                    const AuthTokens& tokens = {}, ConnectionGuard* guard = nullptr);
 
 }  // namespace tessera::server

@@ -28,5 +28,8 @@ struct ServerOptions {
 int parse_server_args(int argc, char** argv, ServerOptions& options);
 /// Runs until SIGTERM/SIGINT; returns the exit code.
 int run_server(const ServerOptions& options);
+/// `tessera-server --plan-scene`: plans one scene for the coordinator (scene_planner.h), reading
+/// the request on stdin and answering on stdout; the exit code.
+int run_scene_planner_main();
 
 }  // namespace tessera::server

@@ -44,6 +44,12 @@ struct WorkerRow {
   double registered = 0;
 };
 
+struct LeaseRow {
+  uint64_t id = 0;
+  uint32_t tile = 0, pass = 0;
+  uint64_t worker = 0;
+};
+
 struct ResultRow {
   uint32_t tile = 0, pass = 0;
   uint64_t worker = 0;
@@ -78,6 +84,11 @@ class Store {
   /// restart test reads).
   uint64_t reissued_after_ack(uint64_t job);
   uint64_t leases_issued(uint64_t job);
+  /// Each unit's newest lease when the unit has no result: the work in flight when the previous
+  /// process stopped.
+  std::vector<LeaseRow> open_leases(uint64_t job);
+  /// Leases logged and results stored, over every job still here (the /metrics counters' start).
+  std::pair<uint64_t, uint64_t> lease_and_result_counts();
 
   // Retention (retention.cpp): sizes, deletion of a finished job, tombstones for its id.
   /// Bytes of stored result data per job (only the jobs in `ids`, or every job when empty).

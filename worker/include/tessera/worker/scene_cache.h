@@ -5,7 +5,7 @@
 
 #include "tessera/farm/protocol.h"
 #include "tessera/render/scene.h"
-#include "tessera/worker/farm_client.h"
+#include "tessera/client/farm_api.h"
 
 #include <cstdint>
 #include <future>
@@ -29,15 +29,15 @@ class SceneCache {
   /// The loaded scene for a lease; downloads, unpacks and loads on first use. Concurrent callers
   /// for the same scene wait for one load. Throws std::runtime_error (download/bundle problems) or
   /// the loader's SceneError/UnsupportedError.
-  std::shared_ptr<const CachedScene> get(const Lease& lease, const FarmClient& client);
+  std::shared_ptr<const CachedScene> get(const Lease& lease, const client::FarmApi& api);
 
   size_t loaded_scenes() const;
   /// Number of bundle downloads so far (a test checks each bundle is fetched once).
   uint64_t downloads() const { return downloads_; }
 
  private:
-  std::string bundle_file(const Lease& lease, const FarmClient& client);
-  std::shared_ptr<const CachedScene> load(const Lease& lease, const FarmClient& client);
+  std::string bundle_file(const Lease& lease, const client::FarmApi& api);
+  std::shared_ptr<const CachedScene> load(const Lease& lease, const client::FarmApi& api);
   void evict_locked();
 
   std::string dir_;

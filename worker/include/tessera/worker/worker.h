@@ -4,7 +4,7 @@
 // stop finishes the passes it is rendering, hands back the rest and signs off.
 #pragma once
 
-#include "tessera/worker/farm_client.h"
+#include "tessera/client/farm_api.h"
 #include "tessera/worker/scene_cache.h"
 
 #include <atomic>
@@ -50,7 +50,7 @@ class Worker {
   void backoff(int& attempt, bool interruptible = true);
 
   WorkerOptions opt_;
-  FarmClient client_;
+  client::FarmApi api_;
   SceneCache cache_;
   std::atomic<bool> stop_{false}, refused_{false};
   std::atomic<uint64_t> worker_id_{0};

@@ -74,6 +74,19 @@ struct WorkerHello {
 nlohmann::json to_json(const WorkerHello& h);
 [[nodiscard]] bool worker_hello_from_json(const nlohmann::json& j, WorkerHello& out, std::string& error);
 
+/// A lease a worker still holds, as its heartbeat reports it ({"leases": [...]}).
+struct HeldLease {
+  uint64_t id = 0, job = 0;
+  uint32_t tile = 0, pass = 0;
+};
+
+/// A worker never holds more leases than this (one per thread): a longer heartbeat is refused.
+inline constexpr size_t kMaxHeldLeases = 4096;
+
+nlohmann::json heartbeat_to_json(const std::vector<HeldLease>& held);
+/// Strict: {"leases": [{"id", "job", "tile", "pass"}, ...]} and nothing else.
+[[nodiscard]] bool heartbeat_from_json(const nlohmann::json& j, std::vector<HeldLease>& out, std::string& error);
+
 /// A bearer token from a flag, a file or the environment, in that order of precedence: `flag`,
 /// else the first line of `file`, else $`env_var` (empty when none is set). Throws
 /// std::runtime_error naming an unreadable or empty file.

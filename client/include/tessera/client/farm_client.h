@@ -1,5 +1,5 @@
-// A small HTTP client for the farm's API (docs/api.md), shared by tessera-worker and the
-// `tessera submit/jobs/cancel` commands. Never throws: transport failures are status 0.
+// The transport under FarmApi (farm_api.h): HTTP(S) requests to one coordinator with its bearer
+// token. Never throws: transport failures are status 0. Tests of the HTTP surface use it directly.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -7,7 +7,7 @@
 #include <map>
 #include <string>
 
-namespace tessera::farm {
+namespace tessera::client {
 
 struct HttpReply {
   int status = 0;          // 0: no answer (connection refused, timeout, ...)
@@ -35,11 +35,12 @@ class FarmClient {
   HttpReply del(const std::string& path, const nlohmann::json& body = nlohmann::json::object(),
                 double timeout_seconds = 30) const;
   HttpReply post_json(const std::string& path, const nlohmann::json& body, double timeout_seconds = 30) const;
+  HttpReply patch_json(const std::string& path, const nlohmann::json& body, double timeout_seconds = 30) const;
   HttpReply post_bytes(const std::string& path, const std::string& bytes, const std::string& content_type,
                        double timeout_seconds = 60) const;
   /// multipart/form-data with a JSON field "settings" and a file field "bundle".
-  HttpReply post_job_with_bundle(const nlohmann::json& settings, const std::string& bundle,
-                                 double timeout_seconds = 600) const;
+  HttpReply post_settings_and_bundle(const std::string& path, const nlohmann::json& settings,
+                                     const std::string& bundle, double timeout_seconds = 600) const;
 
  private:
   std::string url_, host_, token_, ca_file_;
@@ -47,4 +48,4 @@ class FarmClient {
   bool tls_ = false;
 };
 
-}  // namespace tessera::farm
+}  // namespace tessera::client

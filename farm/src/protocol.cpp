@@ -238,6 +238,37 @@ bool worker_hello_from_json(const json& j, WorkerHello& out, std::string& error)
   return true;
 }
 
+json heartbeat_to_json(const std::vector<HeldLease>& held) {
+  json leases = json::array();
+  for (const HeldLease& l : held) leases.push_back({{"id", l.id}, {"job", l.job}, {"tile", l.tile}, {"pass", l.pass}});
+  return json{{"leases", leases}};
+}
+
+bool heartbeat_from_json(const json& j, std::vector<HeldLease>& out, std::string& error) {
+  Fields f(j, error, "heartbeat");
+  json leases = json::array();
+  f.get("leases", leases);
+  f.finish();
+  if (!f.ok()) return false;
+  if (!leases.is_array() || leases.size() > kMaxHeldLeases) {
+    error = "heartbeat: 'leases' must be an array of at most " + std::to_string(kMaxHeldLeases) + " leases";
+    return false;
+  }
+  out.clear();
+  for (const json& item : leases) {
+    HeldLease l;
+    Fields g(item, error, "heartbeat lease");
+    g.get("id", l.id, true);
+    g.get("job", l.job, true);
+    g.get("tile", l.tile, true);
+    g.get("pass", l.pass, true);
+    g.finish();
+    if (!g.ok()) return false;
+    out.push_back(l);
+  }
+  return true;
+}
+
 std::string resolve_token(const std::string& flag, const std::string& file, const char* env_var) {
   if (!flag.empty()) return flag;
   if (!file.empty()) {

@@ -5,7 +5,7 @@
 // against the bytes actually produced (a header that lies cannot get past the limit).
 #include "tessera/farm/bundle.h"
 
-#include "farm/bundle_walk.h"
+#include "bundle_walk.h"
 
 #include <archive.h>
 #include <archive_entry.h>
@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdio>
 #include <memory>
 #include <set>
 #include <stdexcept>
@@ -114,7 +115,28 @@ std::string verify_gzip(const std::string& bytes, uint64_t cap) {
   return error;
 }
 
+/// Why a bundle of `bundle_bytes` may not unpack past `limits.unpacked_limit(bundle_bytes)`,
+/// naming the tessera-server flag that sets the limit in force.
+std::string unpacked_limit_text(const BundleLimits& limits, uint64_t bundle_bytes) {
+  const uint64_t limit = limits.unpacked_limit(bundle_bytes);
+  if (limit < limits.max_unpacked_bytes) {
+    char ratio[32];
+    std::snprintf(ratio, sizeof ratio, "%g", limits.max_ratio);
+    return "unpacked size exceeds " + std::to_string(limit) + " bytes, the compression-ratio limit for a bundle of " +
+           std::to_string(bundle_bytes) + " bytes (" + std::to_string(limits.ratio_floor_bytes) + " + " + ratio +
+           " x its size; --max-ratio): a decompression bomb, or a scene that needs a higher --max-ratio";
+  }
+  return "unpacked size exceeds the limit of " + std::to_string(limits.max_unpacked_bytes) + " bytes (--max-unpacked)";
+}
+
 }  // namespace
+
+uint64_t BundleLimits::unpacked_limit(uint64_t bundle_bytes) const {
+  if (!(max_ratio > 0)) return max_unpacked_bytes;
+  // In floating point: max_ratio x a 4 GiB bundle may not fit in 64 bits.
+  const double by_ratio = double(ratio_floor_bytes) + max_ratio * double(bundle_bytes);
+  return by_ratio >= double(max_unpacked_bytes) ? max_unpacked_bytes : uint64_t(by_ratio);
+}
 
 namespace detail {
 
@@ -148,7 +170,8 @@ BundleResult walk_bundle(const std::string& bytes, const BundleLimits& limits, E
   uint64_t entries = 0, declared_bytes = 0, actual_bytes = 0;
   std::string last = "";
   std::vector<char> buf(size_t(64) << 10);
-  const std::string limit_text = "unpacked size exceeds the limit of " + std::to_string(limits.max_unpacked_bytes) + " bytes";
+  const uint64_t max_unpacked = limits.unpacked_limit(bytes.size());
+  const std::string limit_text = unpacked_limit_text(limits, bytes.size());
   for (;;) {
     archive_entry* e = nullptr;
     int rc = archive_read_next_header(a, &e);
@@ -227,7 +250,7 @@ BundleResult walk_bundle(const std::string& bytes, const BundleLimits& limits, E
       r.error = entry_error(shown, "negative size in header (corrupt bundle)");
       return r;
     }
-    if (uint64_t(declared) > limits.max_unpacked_bytes - declared_bytes) {
+    if (uint64_t(declared) > max_unpacked - declared_bytes) {
       r.error = entry_error(shown, limit_text);
       return r;
     }
@@ -247,7 +270,7 @@ BundleResult walk_bundle(const std::string& bytes, const BundleLimits& limits, E
       }
       if (n == 0) break;
       got += uint64_t(n);
-      if (uint64_t(n) > limits.max_unpacked_bytes - actual_bytes) {
+      if (uint64_t(n) > max_unpacked - actual_bytes) {
         r.error = entry_error(shown, limit_text);
         return r;
       }

@@ -2,7 +2,7 @@
 // private temporary folder, renamed into place only when the whole bundle was good.
 #include "tessera/farm/bundle.h"
 
-#include "farm/bundle_walk.h"
+#include "bundle_walk.h"
 
 #include <fcntl.h>
 #include <unistd.h>

@@ -1,8 +1,8 @@
-#include "tessera/worker/farm_client.h"
+#include "tessera/client/farm_client.h"
 
 #include <httplib.h>
 
-namespace tessera::farm {
+namespace tessera::client {
 
 using nlohmann::json;
 
@@ -107,17 +107,22 @@ HttpReply FarmClient::post_json(const std::string& path, const json& body, doubl
   return reply_of(make_client({host_, port_, tls_, token_, ca_file_}, timeout)->Post(path.c_str(), body.dump(), "application/json"));
 }
 
+HttpReply FarmClient::patch_json(const std::string& path, const json& body, double timeout) const {
+  return reply_of(make_client({host_, port_, tls_, token_, ca_file_}, timeout)->Patch(path.c_str(), body.dump(), "application/json"));
+}
+
 HttpReply FarmClient::post_bytes(const std::string& path, const std::string& bytes, const std::string& type,
                                  double timeout) const {
   return reply_of(make_client({host_, port_, tls_, token_, ca_file_}, timeout)->Post(path.c_str(), bytes, type.c_str()));
 }
 
-HttpReply FarmClient::post_job_with_bundle(const json& settings, const std::string& bundle, double timeout) const {
+HttpReply FarmClient::post_settings_and_bundle(const std::string& path, const json& settings, const std::string& bundle,
+                                               double timeout) const {
   httplib::MultipartFormDataItems items = {
       {"settings", settings.dump(), "settings.json", "application/json"},
       {"bundle", bundle, "scene.tar.gz", "application/gzip"},
   };
-  return reply_of(make_client({host_, port_, tls_, token_, ca_file_}, timeout)->Post("/api/v1/jobs", items));
+  return reply_of(make_client({host_, port_, tls_, token_, ca_file_}, timeout)->Post(path.c_str(), items));
 }
 
-}  // namespace tessera::farm
+}  // namespace tessera::client

@@ -1,0 +1,77 @@
+// The farm's HTTP API (docs/api.md) as typed calls: what tessera-worker, `tessera submit/jobs/
+// cancel` and the benchmarks send. The API's paths are spelt here and in the server's routes only.
+// Never throws: a transport failure is status 0 in `http`, a 2xx body that does not decode is an
+// `error` (and ok() is false).
+#pragma once
+
+#include "tessera/client/farm_client.h"
+#include "tessera/farm/protocol.h"
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace tessera::client {
+
+/// A reply and, for a 2xx answer, its decoded body.
+template <class T>
+struct ApiReply {
+  HttpReply http;
+  T value{};
+  std::string error;  // a 2xx whose body did not decode
+  bool ok() const { return http.ok() && error.empty(); }
+  std::string describe() const { return error.empty() ? http.describe() : error; }
+};
+
+/// What the coordinator tells a worker at registration.
+struct Registration {
+  uint64_t id = 0;
+  double lease_timeout = 0, heartbeat_seconds = 0, max_poll_wait = 0;
+};
+
+struct ResultAck {
+  bool accepted = false, duplicate = false;
+};
+
+class FarmApi {
+ public:
+  explicit FarmApi(FarmClient http) : http_(std::move(http)) {}
+  const FarmClient& http() const { return http_; }
+  const std::string& url() const { return http_.url(); }
+  bool valid(std::string* why = nullptr) const { return http_.valid(why); }
+
+  // Scenes and jobs (the client token). Job bodies are the JSON of docs/api.md.
+  HttpReply upload_scene(const std::string& bundle, double timeout = 600) const;
+  HttpReply download_scene(const std::string& hash, double timeout = 600) const;
+  /// Settings naming an uploaded bundle, or with the bundle in the same request (non-empty `bundle`).
+  HttpReply submit_job(const nlohmann::json& settings, const std::string& bundle = "", double timeout = 600) const;
+  HttpReply jobs(double timeout = 30) const;
+  HttpReply job(uint64_t id, double timeout = 30) const;
+  /// format: exr, png or pfm.
+  HttpReply job_image(uint64_t id, const std::string& format, double timeout = 300) const;
+  HttpReply cancel_job(uint64_t id, double timeout = 30) const;
+  HttpReply set_priority(uint64_t id, int priority, double timeout = 30) const;
+  HttpReply retry_job(uint64_t id, double timeout = 30) const;
+  HttpReply workers(double timeout = 30) const;
+  HttpReply drain_worker(uint64_t worker, double timeout = 30) const;
+  HttpReply health(double timeout = 5) const;
+  HttpReply metrics(double timeout = 30) const;
+
+  // The worker protocol (the worker token).
+  ApiReply<Registration> register_worker(const WorkerHello& hello, double timeout = 30) const;
+  /// A long poll of up to `wait` seconds: a lease (200), or none for now (204, value empty).
+  ApiReply<std::optional<Lease>> lease(uint64_t worker, double wait, double timeout) const;
+  /// The ids among `held` the coordinator no longer wants (cancelled, or delivered by another).
+  ApiReply<std::vector<uint64_t>> heartbeat(uint64_t worker, const std::vector<HeldLease>& held,
+                                            double timeout = 10) const;
+  ApiReply<ResultAck> upload_result(uint64_t worker, uint64_t lease, const std::string& tile_result,
+                                    double timeout = 60) const;
+  HttpReply fail_lease(uint64_t worker, uint64_t lease, const std::string& error, double timeout = 10) const;
+  HttpReply sign_off(uint64_t worker, double timeout = 10) const;
+
+ private:
+  FarmClient http_;
+};
+
+}  // namespace tessera::client

@@ -1,0 +1,82 @@
+// The one place a job's phase changes (coordinator_impl.h, change_phase):
+//
+//   Queued -> Running                 its first lease
+//   Queued/Running -> Done            its last planned unit arrived (or it stopped at its target)
+//   Queued/Running -> Failed          its work failed on too many workers
+//   Queued/Running -> Cancelled       a client cancelled it
+//   Failed/Cancelled -> Queued        a client retried it (keeping the passes it has)
+//
+// Each change sets the job's times, is persisted before it is visible, ends the job's leases when
+// it ends, and is logged; an ended job's image is written and its webhook called (save_phase).
+#include "coordinator_impl.h"
+#include "event_log.h"
+
+#include <spdlog/spdlog.h>
+
+namespace tessera::server {
+
+namespace {
+
+bool allowed(JobPhase from, JobPhase to) {
+  switch (to) {
+    case JobPhase::Running: return from == JobPhase::Queued;
+    case JobPhase::Done:
+    case JobPhase::Failed:
+    case JobPhase::Cancelled: return !is_terminal(from);
+    case JobPhase::Queued: return from == JobPhase::Failed || from == JobPhase::Cancelled;
+  }
+  return false;
+}
+
+void log_change(const JobState& job, JobPhase to) {
+  const uint64_t id = job.id();
+  switch (to) {
+    case JobPhase::Running: return log_event(spdlog::level::info, "job.started", {{"job", id}});
+    case JobPhase::Done:
+      return log_event(spdlog::level::info, "job.done",
+                       {{"job", id}, {"seconds", job.finished - job.started}, {"spp", job.spp_complete()},
+                        {"stopped_at_target", job.converged()}});
+    case JobPhase::Failed: return log_event(spdlog::level::err, "job.failed", {{"job", id}, {"reason", job.error}});
+    case JobPhase::Cancelled: return log_event(spdlog::level::info, "job.cancelled", {{"job", id}});
+    case JobPhase::Queued:
+      return log_event(spdlog::level::info, "job.retried",
+                       {{"job", id}, {"units_done", job.done_units()}, {"units", job.num_units()}});
+  }
+}
+
+}  // namespace
+
+void Coordinator::Impl::change_phase(JobState& job, JobPhase to, const std::string& error) {
+  if (!allowed(job.phase, to))
+    throw std::logic_error(std::string("job ") + std::to_string(job.id()) + ": no transition from " +
+                           phase_name(job.phase) + " to " + phase_name(to));
+  const JobPhase from = job.phase;
+  const double started = job.started, finished = job.finished;
+  const std::string old_error = job.error;
+  const double now = wall_seconds();
+  job.phase = to;
+  if (to == JobPhase::Running) job.started = now;
+  if (is_terminal(to)) job.finished = now;
+  if (to == JobPhase::Failed) job.error = error;
+  if (to == JobPhase::Queued) {
+    job.finished = 0;
+    job.error.clear();
+  }
+  try {
+    store.set_job_state(job.id(), phase_name(job.phase), job.error, job.started, job.finished);
+  } catch (...) {  // not persisted: as if it had not happened (a full disk; the client retries)
+    job.phase = from;
+    job.started = started;
+    job.finished = finished;
+    job.error = old_error;
+    throw;
+  }
+  if (is_terminal(to)) end_leases_if([&](const LeaseInfo& l) { return l.job == job.id(); });
+  log_change(job, to);
+  work_cv.notify_all();
+  // (A full disk can stop the image here: the job has ended all the same, and the retention pass
+  // writes the image later from the film it keeps until then.)
+  if (is_terminal(to)) finish_job(job, /*notify=*/true);
+}
+
+}  // namespace tessera::server

@@ -1,0 +1,63 @@
+// Helpers for the coordinator's in-process tests: a tiny scene and its bundle, worker
+// registration with this build's fingerprint, and delivering real renders of leased units.
+#pragma once
+
+#include "tessera/farm/build_fingerprint.h"
+#include "tessera/farm/bundle.h"
+#include "tessera/farm/job_scene.h"
+#include "tessera/farm/tile_result.h"
+#include "tessera/render/renderer.h"
+#include "tessera/scene/load_context.h"
+#include "tessera/scene/scene_desc.h"
+#include "tessera/server/coordinator.h"
+#include "test_support.h"
+
+namespace tessera::test {
+
+inline constexpr const char* kXml = R"(<scene version="0.6.0">
+  <sensor type="perspective"><float name="fov" value="45"/>
+    <sampler type="independent"><integer name="sampleCount" value="5"/></sampler>
+    <film type="hdrfilm"><integer name="width" value="20"/><integer name="height" value="12"/></film>
+  </sensor>
+  <shape type="sphere"><point name="center" x="0" y="0" z="4"/></shape>
+  <emitter type="constant"/>
+</scene>)";
+
+inline std::string bundle() {
+  TempDir src;
+  src.write("scene.xml", kXml);
+  return pack_bundle(src.path.string(), {"scene.xml"});
+}
+
+inline uint64_t add_worker(server::Coordinator& c, const std::string& name) {
+  const BuildFingerprint& fp = build_fingerprint();
+  auto r = c.register_worker(nlohmann::json{{"name", name}, {"version", fp.version}, {"isa", fp.isa}, {"probe", fp.probe}});
+  EXPECT_TRUE(r.ok()) << r.status.detail;
+  return r.value.value("id", uint64_t(0));
+}
+
+inline server::CoordinatorOptions options(const TempDir& dir) {
+  server::CoordinatorOptions o;
+  o.data_dir = (dir.path / "data").string();
+  return o;
+}
+
+// Renders a leased unit for real (the scene's seed replaced by `seed`) as a tile result's bytes.
+inline std::string render_unit(const nlohmann::json& lease_json, const Scene& scene, uint32_t seed) {
+  Lease lease;
+  std::string error;
+  EXPECT_TRUE(lease_from_json(lease_json, lease, error)) << error;
+  lease.settings.seed = seed;
+  return encode_tile_result(render_lease(scene, lease));
+}
+
+// Leases and delivers one unit for real; false when there was nothing to lease.
+inline bool deliver_one(server::Coordinator& c, uint64_t worker, const Scene& scene, uint32_t seed) {
+  nlohmann::json l = c.lease(worker, 0).value;
+  if (!l.is_object()) return false;
+  auto up = c.upload_result(worker, l["id"], render_unit(l, scene, seed));
+  EXPECT_TRUE(up.ok()) << up.status.detail;
+  return true;
+}
+
+}  // namespace tessera::test

@@ -1,0 +1,57 @@
+// The coordinator's memory does not grow with submissions: a large scene is planned in a
+// short-lived child process, and a job's film is allocated only when its first result arrives.
+// A looser bound than the benchmark's (bench/coordinator_memory.sh), with fewer cycles.
+#include "farm_harness.h"
+
+#include <fstream>
+
+namespace tessera::test {
+namespace {
+
+using nlohmann::json;
+
+double resident_mb(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
+  for (std::string key; in >> key;) {
+    if (key == "VmRSS:") {
+      double kb = 0;
+      in >> kb;
+      return kb / 1024;
+    }
+    in.ignore(1 << 20, '\n');
+  }
+  return -1;
+}
+
+TEST(FarmMemory, SubmissionsOfALargeSceneLeaveNoRenderStateBehind) {
+  const std::string scene = shared_path("scenes/living-room/scene.xml");
+  TESSERA_REQUIRE_FILE(scene);
+  Farm farm;
+  farm.start_server();
+  // One upload; then jobs name the bundle by its hash, as a frame range or a re-render would.
+  JobSettings settings;
+  auto abs = std::filesystem::absolute(scene);
+  LoadedJobScene loaded = load_job_scene(abs.parent_path().string(), abs.filename().string(), settings, false);
+  BundlePlan plan = plan_bundle(abs.string(), scene_files(loaded.desc, loaded.loaded));
+  client::HttpReply up = farm.api().upload_scene(pack_bundle(plan.root_dir, plan.files));
+  ASSERT_EQ(up.status, 201) << up.body;
+  const json body = {{"scene", up.json()["hash"]}, {"scene_file", plan.files.front()}, {"spp", 64},
+                     {"width", 1280}, {"height", 720}};
+  const double start = resident_mb(farm.server_pid());
+  for (int i = 0; i < 8; ++i) {
+    client::HttpReply r = farm.api().submit_job(body);
+    ASSERT_EQ(r.status, 201) << r.body;
+    ASSERT_TRUE(farm.api().cancel_job(r.json()["id"]).ok());
+  }
+  const double cycled = resident_mb(farm.server_pid());
+  for (int i = 0; i < 8; ++i) ASSERT_EQ(farm.api().submit_job(body).status, 201);
+  const double queued = resident_mb(farm.server_pid());
+  std::printf("coordinator RSS: %.0f MB at start, %.0f MB after 8 submit+cancel, %.0f MB with 8 jobs queued\n", start,
+              cycled, queued);
+  // In-process loading kept ~150 MB per living-room submission; a 1280x720 film is 52 MB.
+  EXPECT_LT(cycled, 250);
+  EXPECT_LT(queued, 250);
+}
+
+}  // namespace
+}  // namespace tessera::test
