@@ -3,13 +3,15 @@
 # untouched and once with one worker killed (kill -9) at 90% progress, alternating ROUNDS times.
 # Prints each run's wall time from submission to done; the images must be identical (checked).
 # Builds nothing; needs curl and jq.
-# Usage: bench/farm_failover.sh [BUILD_DIR] [ROUNDS] [SPP] [SIZE]
+# Usage: bench/farm_failover.sh [BUILD_DIR] [ROUNDS] [SPP] [SIZE] [SERVER_FLAGS]
+#   e.g. SERVER_FLAGS=--no-speculation: the dead worker's units wait for it to miss 3 heartbeats
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build}
 rounds=${2:-3}
 spp=${3:-64}
 size=${4:-128}
+read -r -a server_flags <<< "${5:-}"
 scene=../shared/scenes/cornell-box
 tmp=$(mktemp -d)
 pids=()
@@ -25,12 +27,12 @@ run() {
   local kill_at=$1 dir="$tmp/run$RANDOM"
   mkdir -p "$dir"
   "$build/server/tessera-server" --listen 127.0.0.1:0 --port-file "$dir/port" --data-dir "$dir/data" \
-      --log-level warn 2> "$dir/server.log" &
+      --log-level warn "${server_flags[@]}" > "$dir/server.log" 2>&1 &
   pids+=($!)
   for _ in $(seq 100); do [ -s "$dir/port" ] && break; sleep 0.1; done
   local s="http://127.0.0.1:$(cat "$dir/port")" w0 w1
-  "$build/worker/tessera-worker" --server "$s" --threads 1 --cache-dir "$dir/c0" 2> "$dir/w0.log" & w0=$!
-  "$build/worker/tessera-worker" --server "$s" --threads 1 --cache-dir "$dir/c1" 2> "$dir/w1.log" & w1=$!
+  "$build/worker/tessera-worker" --server "$s" --threads 1 --cache-dir "$dir/c0" > "$dir/w0.log" 2>&1 & w0=$!
+  "$build/worker/tessera-worker" --server "$s" --threads 1 --cache-dir "$dir/c1" > "$dir/w1.log" 2>&1 & w1=$!
   pids+=("$w0" "$w1")
   local id start state progress killed=0
   id=$(curl -sS --fail-with-body -F "settings={\"spp\": $spp, \"width\": $size, \"height\": $size, \"tile_size\": 16};type=application/json" \
@@ -55,8 +57,8 @@ run() {
 }
 
 tar czf "$tmp/cornell.tar.gz" -C "$scene" scene.xml
-printf "cornell-box %sx%s, %s spp, 16-pixel tiles, 2 workers x 1 thread; seconds from submission to done\n" \
-    "$size" "$size" "$spp"
+printf "cornell-box %sx%s, %s spp, 16-pixel tiles, 2 workers x 1 thread, server flags '%s'; seconds from submission to done\n" \
+    "$size" "$size" "$spp" "${5:-}"
 for r in $(seq "$rounds"); do
   untouched=$(run 0)
   killed=$(run 1)
