@@ -12,20 +12,19 @@ fails instead).
 import argparse
 import json
 import os
-import shutil
 import signal
 import subprocess
 import sys
 import tarfile
-import tempfile
 import time
-import traceback
 import urllib.error
 import urllib.request
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-SKIP = 77
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "support"))
+from script_test import SKIP, Failure, run_in_temp_dir  # noqa: E402
+
 CHROMIUM = "/usr/bin/chromium"
 CHROMEDRIVER = "/usr/bin/chromedriver"
 SYSTEM_PYTHON = "/usr/bin/python3"  # Debian's selenium lives in its dist-packages
@@ -53,10 +52,6 @@ def missing_tools():
     missing = [] if webdriver is not None else ["python3-selenium"]
     missing += [p for p in (CHROMIUM, CHROMEDRIVER) if not os.access(p, os.X_OK)]
     return missing
-
-
-class Failure(Exception):
-    pass
 
 
 def check(condition, message):
@@ -350,20 +345,7 @@ def main():
             print(f"FAIL: {path} does not exist")
             return 1
 
-    tmp = Path(tempfile.mkdtemp(prefix="tessera-dashboard-"))
-    try:
-        run(args, tmp)
-    except Failure as e:
-        print(f"FAIL: {e}")
-        return 1
-    except Exception:
-        traceback.print_exc()
-        print("FAIL: unexpected error")
-        return 1
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
-    print("PASS")
-    return 0
+    return run_in_temp_dir("tessera-dashboard-", run, args)
 
 
 if __name__ == "__main__":

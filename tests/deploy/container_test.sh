@@ -19,18 +19,8 @@ settings=(--spp 16 --width 128 --height 96)
 project=tessera-test-$$
 image=localhost/tessera:test
 
-skip() {
-  if [ "${CI:-}" = "true" ]; then
-    echo "FAIL: $* (CI=true: a missing tool is a failure)"
-    exit 1
-  fi
-  echo "SKIP: $*"
-  exit 77
-}
-fail() {
-  echo "FAIL: $*"
-  exit 1
-}
+# shellcheck source=../support/script_test.sh
+source "$(dirname "${BASH_SOURCE[0]}")/../support/script_test.sh"
 
 [ "$(id -u)" -eq 0 ] || skip "debootstrap and rootful podman need root"
 for tool in podman podman-compose debootstrap curl python3 openssl; do

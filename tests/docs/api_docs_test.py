@@ -21,24 +21,20 @@ import shutil
 import signal
 import subprocess
 import sys
-import tempfile
 import time
-import traceback
 import urllib.request
 from dataclasses import dataclass, field
 from pathlib import Path
 
-SKIP = 77
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "support"))
+from script_test import SKIP, Failure, run_in_temp_dir  # noqa: E402
+
 REPO = Path(__file__).resolve().parents[2]
 TOOLS = ("bash", "curl", "jq", "tar", "openssl")
 CLIENT_TOKEN = "docs-client-7f3a"
 WORKER_TOKEN = "docs-worker-21c9"
 EXPECT = re.compile(r"#\s*expect:\s*(\d{3})\b")
 DOCS_NAME = "docs/api.md"  # in messages; set from --docs
-
-
-class Failure(Exception):
-    pass
 
 
 # ---- reading the docs -----------------------------------------------------------------------
@@ -358,20 +354,7 @@ def main():
     if missing:
         print(f"{'FAIL' if ci else 'SKIP'}: missing {', '.join(missing)}")
         return 1 if ci else SKIP
-    tmp = Path(tempfile.mkdtemp(prefix="tessera-docs-"))
-    try:
-        run(args, tmp)
-    except Failure as e:
-        print(f"FAIL: {e}")
-        return 1
-    except Exception:
-        traceback.print_exc()
-        print("FAIL: unexpected error")
-        return 1
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
-    print("PASS")
-    return 0
+    return run_in_temp_dir("tessera-docs-", run, args)
 
 
 if __name__ == "__main__":

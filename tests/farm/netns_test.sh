@@ -22,18 +22,8 @@ scene=$root/scenes/demo/scene.xml
 # Small enough for ~10 s on two cores, with enough work units (48 tiles x 5 passes) for both workers.
 settings=(--spp 16 --width 128 --height 96)
 
-skip() {
-  if [ "${CI:-}" = "true" ]; then
-    echo "FAIL: $* (CI=true: a missing tool is a failure)"
-    exit 1
-  fi
-  echo "SKIP: $*"
-  exit 77
-}
-fail() {
-  echo "FAIL: $*"
-  exit 1
-}
+# shellcheck source=../support/script_test.sh
+source "$(dirname "${BASH_SOURCE[0]}")/../support/script_test.sh"
 
 [ "$(id -u)" -eq 0 ] || skip "network namespaces need root"
 command -v ip > /dev/null || skip "ip (iproute2) is missing"
