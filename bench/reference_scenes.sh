@@ -16,7 +16,7 @@ for s in "${scenes[@]}"; do
   res=$(grep -o 'Resolution [0-9]*×[0-9]*' "$shared/references/$s/README.md" | grep -o '[0-9][0-9]*')
   w=$(echo "$res" | sed -n 1p); h=$(echo "$res" | sed -n 2p)
   extra=()
-  [ "$s" = staircase2 ] && extra=(--allow-unsupported)  # its medium: issue 4
+  [ "$s" = staircase2 ] && extra=(--allow-unsupported)  # for its medium
   for spp in 16 64; do
     start=$(date +%s%N)
     "$build/cli/tessera" render "$shared/scenes/$s/scene.xml" -o "$out/$s.exr" --width "$w" --height "$h" \
