@@ -69,7 +69,7 @@ TEST(FarmOps, JobStopsAtItsTargetNoiseAtAPassBoundary) {
   EXPECT_EQ(header["tessera_spp"], std::to_string(spp)) << "the EXR header names the spp reached, not the budget";
   // And `tessera render --target-error` with the same budget stops at the same pass.
   EXPECT_EQ(differing_pixels(image, local_render(cornell(), s)), 0);
-  // And the estimate is an estimate of the truth (printed, judged by people: issue 7 measures it).
+  // And the estimate is an estimate of the truth (printed, judged by people: bench/convergence.sh measures it).
   JobSettings converged = s;
   converged.spp = 1024;
   converged.target_error = 0;

@@ -1,4 +1,4 @@
-// Helpers of the hard-case tests (issue 7): moving a loaded scene description in the world, rendering
+// Helpers of the hard-case tests: moving a loaded scene description in the world, rendering
 // small and deterministically, and the checks every hard case makes (nothing non-finite anywhere).
 #pragma once
 
