@@ -21,6 +21,7 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -37,7 +38,8 @@ volatile std::sig_atomic_t g_interrupted = 0;
 
 struct Options {
   std::string server_bin, csv;
-  int workers = 64, http_threads = 64, tile_size = 32;
+  std::vector<std::string> server_flags;
+  int workers = 64, http_threads = 64, tile_size = 32, loop_threads = 2;
   double seconds = 20, poll_wait = 2, max_poll_wait = 30, tile_seconds = 2;
   uint64_t units = 20000;
 };
@@ -69,7 +71,7 @@ struct TempDir {
   }
 };
 
-// Joins every simulated worker on any exit path (they finish their current unit and sign off).
+// Joins the simulated workers' threads on any exit path (they finish their units and sign off).
 struct WorkerThreads {
   SimShared& shared;
   std::vector<std::thread> threads;
@@ -103,13 +105,23 @@ double percentile(std::vector<double> v, double q) {
   return v[std::min(v.size() - 1, rank > 0 ? rank - 1 : 0)];
 }
 
+// A counter's value in /metrics' text (0 when absent or unreadable).
+double metric_value(const ServerProcess& server, const std::string& series) {
+  const std::string text = client::FarmApi(client::FarmClient(server.url())).metrics(10).body;
+  const size_t at = text.find("\n" + series + " ");
+  return at == std::string::npos ? 0 : std::atof(text.c_str() + at + series.size() + 2);
+}
+constexpr const char* kCommits = "tessera_store_commits_total{result=\"committed\"}";
+
 struct Figures {
   uint64_t units = 0, units_total = 0, result_bytes = 0;
+  double commits = 0;  // state-database transactions (one WAL fsync each) in the measured interval
   double wall = 0, coordinator_cpu = 0, bench_cpu = 0;
   double lease_p50 = 0, lease_p99 = 0, upload_p50 = 0, upload_p99 = 0;
   uint64_t empty_polls = 0;
   double units_per_second() const { return wall > 0 ? double(units) / wall : 0; }
   double cpu_ms_per_unit() const { return units > 0 ? 1000 * coordinator_cpu / double(units) : 0; }
+  double fsyncs_per_unit() const { return units > 0 ? commits / double(units) : 0; }
 };
 
 void report(const Options& o, const JobShape& shape, const Figures& f) {
@@ -119,16 +131,17 @@ void report(const Options& o, const JobShape& shape, const Figures& f) {
               (unsigned long long)f.units_total, std::thread::hardware_concurrency());
   char fed_header[32];
   std::snprintf(fed_header, sizeof(fed_header), "fed@%gs", o.tile_seconds);
-  std::printf("%7s %5s %7s %7s %8s %9s %9s %10s %10s %8s %7s %8s %7s %7s\n", "workers", "http", "units", "wall_s",
+  std::printf("%7s %5s %7s %7s %8s %9s %9s %10s %10s %8s %7s %8s %10s %7s %7s\n", "workers", "http", "units", "wall_s",
               "units/s", "lease_p50", "lease_p99", "upload_p50", "upload_p99", "coord_s", "coord_%", "ms/unit",
-              "bench_%", fed_header);
+              "fsync/unit", "bench_%", fed_header);
   const double fed = f.units_per_second() * o.tile_seconds;
-  std::printf("%7d %5d %7llu %7.2f %8.1f %9.2f %9.2f %10.2f %10.2f %8.2f %7.1f %8.3f %7.1f %7.0f\n", o.workers,
+  std::printf("%7d %5d %7llu %7.2f %8.1f %9.2f %9.2f %10.2f %10.2f %8.2f %7.1f %8.3f %10.3f %7.1f %7.0f\n", o.workers,
               o.http_threads, (unsigned long long)f.units, f.wall, f.units_per_second(), f.lease_p50, f.lease_p99,
               f.upload_p50, f.upload_p99, f.coordinator_cpu, 100 * f.coordinator_cpu / f.wall, f.cpu_ms_per_unit(),
-              100 * f.bench_cpu / f.wall, fed);
+              f.fsyncs_per_unit(), 100 * f.bench_cpu / f.wall, fed);
   std::printf("(latencies in ms; coord_s/coord_%%: the coordinator's utime+stime over the run and as %% of one core; "
-              "bench_%%: the load generator's own CPU; %llu empty polls; %.0f result bytes/unit)\n",
+              "fsync/unit: the state database's commits per unit, one WAL fsync each; bench_%%: the load generator's own CPU; "
+              "%llu empty polls; %.0f result bytes/unit)\n",
               (unsigned long long)f.empty_polls, f.units ? double(f.result_bytes) / double(f.units) : 0.0);
   std::printf("fed@%gs = units/s x %g s per tile: worker slots this coordinator kept supplied at this rate; an upper "
               "bound for real workers (they also heartbeat and fetch bundles, and a saturated coordinator has no "
@@ -143,12 +156,12 @@ void report(const Options& o, const JobShape& shape, const Figures& f) {
   std::ofstream out(o.csv, std::ios::app);
   if (header)
     out << "workers,http_threads,units,wall_s,units_per_s,lease_p50_ms,lease_p99_ms,upload_p50_ms,upload_p99_ms,"
-           "coord_cpu_s,coord_cpu_pct,cpu_ms_per_unit,bench_cpu_pct,workers_fed\n";
+           "coord_cpu_s,coord_cpu_pct,cpu_ms_per_unit,fsync_per_unit,bench_cpu_pct,workers_fed\n";
   char row[512];
-  std::snprintf(row, sizeof(row), "%d,%d,%llu,%.2f,%.1f,%.2f,%.2f,%.2f,%.2f,%.2f,%.1f,%.3f,%.1f,%.0f\n", o.workers,
+  std::snprintf(row, sizeof(row), "%d,%d,%llu,%.2f,%.1f,%.2f,%.2f,%.2f,%.2f,%.2f,%.1f,%.3f,%.3f,%.1f,%.0f\n", o.workers,
                 o.http_threads, (unsigned long long)f.units, f.wall, f.units_per_second(), f.lease_p50, f.lease_p99,
                 f.upload_p50, f.upload_p99, f.coordinator_cpu, 100 * f.coordinator_cpu / f.wall, f.cpu_ms_per_unit(),
-                100 * f.bench_cpu / f.wall, fed);
+                f.fsyncs_per_unit(), 100 * f.bench_cpu / f.wall, fed);
   out << row;
 }
 
@@ -196,7 +209,7 @@ std::vector<std::string> check_run(ServerProcess& server, uint64_t job, const st
 
 int run(const Options& o) {
   TempDir tmp;
-  ServerProcess server(o.server_bin, tmp.path.string(), o.http_threads, o.max_poll_wait);
+  ServerProcess server(o.server_bin, tmp.path.string(), o.http_threads, o.max_poll_wait, o.server_flags);
   client::FarmApi api(client::FarmClient(server.url()));
 
   const JobShape shape = plan_job(o.units);
@@ -218,14 +231,19 @@ int run(const Options& o) {
   f.units_total = units_total;
   {
     WorkerThreads threads{shared, {}};
-    for (int i = 0; i < o.workers; ++i)
-      threads.threads.emplace_back(run_simulated_worker, i, std::ref(shared), std::ref(stats[size_t(i)]));
+    const int loops = std::min(o.workers, o.loop_threads);
+    for (int t = 0, first = 0; t < loops; ++t) {
+      const int count = o.workers / loops + (t < o.workers % loops ? 1 : 0);
+      threads.threads.emplace_back(run_simulated_workers, first, count, std::ref(shared), std::ref(stats));
+      first += count;
+    }
     for (auto end = Clock::now() + std::chrono::seconds(60); shared.registered < o.workers && Clock::now() < end &&
                                                             !g_interrupted;)
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
     if (shared.registered < o.workers) throw std::runtime_error("the workers did not register within 60 s");
 
     // The measured interval: from the start signal until the job is done or the time cap.
+    const double commits0 = metric_value(server, kCommits);
     const double cpu0 = process_cpu_seconds(server.pid()), self0 = self_cpu_seconds();
     const auto t0 = Clock::now();
     shared.start = true;
@@ -236,6 +254,7 @@ int run(const Options& o) {
     f.wall = std::chrono::duration<double>(Clock::now() - t0).count();
     f.coordinator_cpu = process_cpu_seconds(server.pid()) - cpu0;
     f.bench_cpu = self_cpu_seconds() - self0;
+    f.commits = metric_value(server, kCommits) - commits0;
     shared.stop = true;
   }  // joined: every worker has finished its unit and signed off
   if (g_interrupted) return 130;
@@ -273,7 +292,9 @@ int main(int argc, char** argv) {
   Options o;
   CLI::App app{"tessera-farm-load: load benchmark of one coordinator with simulated workers on loopback"};
   app.add_option("--server-bin", o.server_bin, "the tessera-server program")->required()->check(CLI::ExistingFile);
-  app.add_option("--workers", o.workers, "simulated workers (threads)")->check(CLI::Range(1, 512))->capture_default_str();
+  app.add_option("--workers", o.workers, "simulated workers")->check(CLI::Range(1, 5000))->capture_default_str();
+  app.add_option("--loop-threads", o.loop_threads, "threads driving the simulated workers (an event loop each)")
+      ->check(CLI::Range(1, 64))->capture_default_str();
   app.add_option("--seconds", o.seconds, "cap on the measured interval")->check(CLI::Range(0.1, 600.0))->capture_default_str();
   app.add_option("--units", o.units, "work units (tiles x passes) of the job, about")
       ->check(CLI::Range(uint64_t(1), uint64_t(1000000)))->capture_default_str();
@@ -288,6 +309,8 @@ int main(int argc, char** argv) {
   app.add_option("--tile-seconds", o.tile_seconds, "render time per unit of a real worker, for the 'fed' figure")
       ->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--csv", o.csv, "append the figures as a CSV row to this file");
+  app.add_option("--server-flag", o.server_flags, "another flag for tessera-server (repeatable), e.g. "
+                 "--server-flag=--commit-interval=0")->allow_extra_args(false);
   CLI11_PARSE(app, argc, argv);
 
   std::signal(SIGINT, [](int) { tessera::bench::g_interrupted = 1; });

@@ -1,6 +1,7 @@
-// tessera-farm-load: a load benchmark of one coordinator. The pieces the driver (farm_load.cpp)
-// shares with farm_load_sim.cpp: the coordinator as a child process, CPU time of a process, and
-// the simulated workers (real protocol, real client, synthetic tile results, no rendering).
+// tessera-farm-load: a load benchmark of one coordinator. The pieces of the driver (farm_load.cpp):
+// the coordinator as a child process and CPU time of a process (server_process.cpp), and the
+// simulated workers (sim_workers.cpp: real protocol, the client library's requests, synthetic tile
+// results, no rendering; many workers per thread on an event loop).
 #pragma once
 
 #include <sys/types.h>
@@ -17,7 +18,8 @@ namespace tessera::bench {
 /// process (PR_SET_PDEATHSIG) and is stopped (SIGTERM, then SIGKILL) when destroyed.
 class ServerProcess {
  public:
-  ServerProcess(const std::string& binary, const std::string& dir, int http_threads, double max_poll_wait);
+  ServerProcess(const std::string& binary, const std::string& dir, int http_threads, double max_poll_wait,
+                const std::vector<std::string>& extra_args = {});
   ~ServerProcess() { stop(); }
   ServerProcess(const ServerProcess&) = delete;
   ServerProcess& operator=(const ServerProcess&) = delete;
@@ -59,8 +61,9 @@ struct SimStats {
   std::string first_error;
 };
 
-/// Registers, then (once `start`) leases and completes units as fast as the coordinator allows
-/// until `stop`, then signs off. Never throws; problems are counted in `out.errors`.
-void run_simulated_worker(int index, SimShared& shared, SimStats& out);
+/// Registers workers first..first+count-1 (their stats at those indices), then (once `start`)
+/// drives them all from this thread: each leases and completes units as fast as the coordinator
+/// allows until `stop`, then signs off. Never throws; problems are counted in the stats' errors.
+void run_simulated_workers(int first, int count, SimShared& shared, std::vector<SimStats>& stats);
 
 }  // namespace tessera::bench

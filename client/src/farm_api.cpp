@@ -71,14 +71,38 @@ ApiReply<Registration> FarmApi::register_worker(const WorkerHello& hello, double
                               });
 }
 
-ApiReply<std::optional<Lease>> FarmApi::lease(uint64_t worker, double wait, double timeout) const {
-  HttpReply http = http_.post_json(worker_path(worker) + "/lease?wait=" + std::to_string(wait), json::object(), timeout);
+RequestSpec lease_request(uint64_t worker, double wait) {
+  return {"POST", worker_path(worker) + "/lease?wait=" + std::to_string(wait), "application/json", "{}"};
+}
+
+RequestSpec result_request(uint64_t worker, uint64_t lease, std::string tile_result, bool want_next) {
+  return {"POST", worker_path(worker) + "/results?lease=" + std::to_string(lease) + (want_next ? "&next=1" : ""),
+          "application/x-tessera-tile", std::move(tile_result)};
+}
+
+ApiReply<std::optional<Lease>> decode_lease_reply(HttpReply http) {
   if (http.status == 204) return {std::move(http), std::nullopt, ""};
   return decode<std::optional<Lease>>(std::move(http), [](const json& j, ApiReply<std::optional<Lease>>& out) {
     Lease lease;
     if (lease_from_json(j, lease, out.error)) out.value = std::move(lease);
     else out.error = "bad lease from the coordinator: " + out.error;
   });
+}
+
+ApiReply<ResultAck> decode_result_reply(HttpReply http) {
+  return decode<ResultAck>(std::move(http), [](const json& j, ApiReply<ResultAck>& out) {
+    out.value.accepted = j.value("accepted", false);
+    out.value.duplicate = j.value("duplicate", false);
+    if (!j.contains("lease") || j["lease"].is_null()) return;
+    Lease next;
+    if (lease_from_json(j["lease"], next, out.error)) out.value.next = std::move(next);
+    else out.error = "bad lease from the coordinator: " + out.error;
+  });
+}
+
+ApiReply<std::optional<Lease>> FarmApi::lease(uint64_t worker, double wait, double timeout) const {
+  const RequestSpec r = lease_request(worker, wait);
+  return decode_lease_reply(http_.post_bytes(r.path, r.body, r.content_type, timeout));
 }
 
 ApiReply<std::vector<uint64_t>> FarmApi::heartbeat(uint64_t worker, const std::vector<HeldLease>& held,
@@ -89,13 +113,9 @@ ApiReply<std::vector<uint64_t>> FarmApi::heartbeat(uint64_t worker, const std::v
 }
 
 ApiReply<ResultAck> FarmApi::upload_result(uint64_t worker, uint64_t lease, const std::string& tile_result,
-                                           double timeout) const {
-  return decode<ResultAck>(http_.post_bytes(worker_path(worker) + "/results?lease=" + std::to_string(lease),
-                                            tile_result, "application/x-tessera-tile", timeout),
-                           [](const json& j, ApiReply<ResultAck>& out) {
-                             out.value.accepted = j.value("accepted", false);
-                             out.value.duplicate = j.value("duplicate", false);
-                           });
+                                           double timeout, bool want_next) const {
+  const RequestSpec r = result_request(worker, lease, tile_result, want_next);
+  return decode_result_reply(http_.post_bytes(r.path, r.body, r.content_type, timeout));
 }
 
 HttpReply FarmApi::fail_lease(uint64_t worker, uint64_t lease, const std::string& error, double timeout) const {

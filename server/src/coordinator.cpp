@@ -65,6 +65,7 @@ Coordinator::Coordinator(CoordinatorOptions options) : impl_(std::make_unique<Im
   // Resume: every job's acknowledged passes go back into its film; leases in flight died with the
   // previous process, so their units are simply available again.
   size_t resumed = 0, passes = 0;
+  s.last_lease_id = s.store.last_lease_seq();
   for (JobRow& row : s.store.jobs()) {
     JobPhase phase;
     if (!parse_phase(row.state, phase)) phase = JobPhase::Failed;
@@ -83,9 +84,9 @@ Coordinator::Coordinator(CoordinatorOptions options) : impl_(std::make_unique<Im
     passes += job->done_units();
     try {
       if (!is_terminal(job->phase) && job->complete()) {  // its last result landed before a crash
-        s.change_phase(*job, JobPhase::Done);
+        s.commits.wait(s.change_phase(*job, JobPhase::Done));
       } else if (is_terminal(job->phase)) {
-        s.save_phase(*job, /*notify=*/false);  // it ended before its image was written
+        s.finish_job(*job, /*notify=*/false);  // it ended before its image was written
       } else {
         ++resumed;
         s.hold_open_leases(*job);
@@ -127,6 +128,15 @@ void Coordinator::Impl::hold_open_leases(JobState& job) {
   }
 }
 
+Status Coordinator::Impl::durable(uint64_t ticket) {
+  try {
+    commits.wait(ticket);
+    return Status::success();
+  } catch (const std::exception& e) {
+    return internal_error(e);
+  }
+}
+
 void Coordinator::Impl::end_lease(std::map<uint64_t, LeaseInfo>::iterator it) {
   auto job = jobs.find(it->second.job);
   if (job != jobs.end()) job->second->lease_ended(it->second.unit);
@@ -149,28 +159,59 @@ std::unique_ptr<JobState> Coordinator::Impl::job_from_row(const JobRow& row) con
 
 std::unique_ptr<JobState> Coordinator::Impl::rebuild_job(const JobRow& row) {
   auto job = job_from_row(row);
+  const std::string where = "job " + std::to_string(row.id) + ": ";
+  // Each tile's checkpoint first, then the passes after it, in pass order: the film's sums as they were.
+  store.for_each_checkpoint(row.id, [&](CheckpointRow&& c) {
+    TileResult sums;
+    std::string err;
+    if (!decode_tile_result(c.data, sums, err)) throw std::runtime_error(where + "stored checkpoint is corrupt: " + err);
+    if (c.tile >= job->num_tiles() || c.passes == 0 || c.passes > job->num_passes() ||
+        !(sums.film.rect() == job->rect(job->unit(c.tile, 0))) ||
+        sums.sample_end != job->sample_end(job->unit(c.tile, c.passes - 1)))
+      throw std::runtime_error(where + "stored checkpoint of tile " + std::to_string(c.tile) + " does not fit the job");
+    job->restore_checkpoint(c.tile, c.passes, std::move(sums.film));
+  });
   store.for_each_result(row.id, [&](ResultRow&& r) {
+    if (r.tile >= job->num_tiles() || r.pass >= job->num_passes()) return;
+    const size_t unit = job->unit(r.tile, r.pass);
+    if (r.data.empty()) return job->mark_done(unit, r.worker);  // (held by its tile's checkpoint)
     TileResult result;
     std::string err;
-    if (!decode_tile_result(r.data, result, err))
-      throw std::runtime_error("job " + std::to_string(row.id) + ": stored result is corrupt: " + err);
-    if (r.tile < job->num_tiles() && r.pass < job->num_passes())
-      (void)job->add_result(job->unit(r.tile, r.pass), std::move(result.film), r.worker);
+    if (!decode_tile_result(r.data, result, err)) throw std::runtime_error(where + "stored result is corrupt: " + err);
+    (void)job->add_result(unit, std::move(result.film), r.worker);
   });
   return job;
+}
+
+void Coordinator::Impl::checkpoint_tile(JobState& job, uint32_t tile, uint32_t min_new) {
+  std::optional<JobState::Checkpoint> cp = job.take_checkpoint(tile, min_new);
+  if (!cp) return;
+  auto shared = std::make_shared<JobState::Checkpoint>(std::move(*cp));
+  (void)commits.append(
+      [id = job.id(), shared](Store& st) {
+        TileResult sums;
+        sums.job_id = id;
+        sums.tile = shared->tile;
+        sums.pass = shared->passes - 1;
+        sums.sample_end = shared->sample_end;
+        sums.film = std::move(shared->sums);
+        st.save_checkpoint(id, shared->tile, shared->from, shared->passes, encode_tile_result(sums));
+      },
+      GroupCommit::Retry::No,
+      [this, id = job.id(), tile = shared->tile, from = shared->from](bool durable) {
+        auto it = jobs.find(id);
+        if (!durable && it != jobs.end()) it->second->checkpoint_failed(tile, from);
+      });
 }
 
 std::string Coordinator::Impl::image_path(uint64_t job) const {
   return (fs::path(opt.data_dir) / "images" / (std::to_string(job) + ".exr")).string();
 }
 
-void Coordinator::Impl::save_phase(JobState& job, bool notify) {
-  store.set_job_state(job.id(), phase_name(job.phase), job.error, job.started, job.finished);
-  finish_job(job, notify);
-}
-
 void Coordinator::Impl::finish_job(JobState& job, bool notify) {
   if (is_terminal(job.phase) && job.has_film()) {
+    // Its sums stay (a retried job goes on from them) as one checkpoint per tile, not as results.
+    for (uint32_t t = 0; t < job.num_tiles(); ++t) checkpoint_tile(job, t, 1);
     const std::string path = image_path(job.id());
     write_image_durably(path, job.image(),
                 {{"tessera_version", TESSERA_VERSION}, {"tessera_job", std::to_string(job.id())},
@@ -255,6 +296,14 @@ std::string Coordinator::metrics() {
   out += "tessera_webhooks_total{result=\"delivered\"} " + std::to_string(s.webhooks.delivered()) + "\n";
   out += "tessera_webhooks_total{result=\"failed\"} " + std::to_string(s.webhooks.failed()) + "\n";
   out += retention_metrics(s.retention);
+  const GroupCommit::Stats commits = s.commits.stats();
+  out += metric_header("tessera_store_commits_total", "counter",
+                       "State database transactions committed by the group commit (one WAL fsync each), and failed.");
+  out += "tessera_store_commits_total{result=\"committed\"} " + std::to_string(commits.commits) + "\n";
+  out += "tessera_store_commits_total{result=\"failed\"} " + std::to_string(commits.failed_batches) + "\n";
+  out += metric_header("tessera_store_records_total", "counter",
+                       "Leases, results and phase changes committed by the group commit.");
+  out += "tessera_store_records_total " + std::to_string(commits.records) + "\n";
   return out;
 }
 

@@ -1,7 +1,9 @@
-// The coordinator's shared state (one mutex guards all of it; SQLite writes happen under it,
-// which serialises them as SQLite would anyway).
+// The coordinator's shared state (one mutex guards all of it). Leases, results and phase changes
+// are decided under it and appended to the group commit there, in that order; requests wait for
+// their records to be durable after releasing it.
 #pragma once
 
+#include "group_commit.h"
 #include "job_state.h"
 #include "metrics.h"
 #include "retention.h"
@@ -9,6 +11,7 @@
 #include "webhooks.h"
 #include "worker_state.h"
 #include "tessera/farm/build_fingerprint.h"
+#include "tessera/farm/tile_result.h"
 #include "tessera/server/coordinator.h"
 #include "tessera/server/store.h"
 
@@ -49,6 +52,7 @@ struct Coordinator::Impl {
   std::map<uint64_t, std::unique_ptr<JobState>> jobs;
   std::map<uint64_t, LeaseInfo> leases;
   std::map<uint64_t, WorkerInfo> workers;
+  uint64_t last_lease_id = 0;  // ids are never reused, also across restarts
   std::atomic<int> waiting_polls{0};
   bool stopping = false;
   std::thread reaper;
@@ -80,8 +84,30 @@ struct Coordinator::Impl {
   }
   /// Under `mu`: the scheduler's choice (scheduler.h) for a worker asking for work.
   std::optional<UnitChoice> choose_unit_for(uint64_t worker);
-  /// Under `mu`: logs and hands out a lease of the chosen unit (the job starts with its first).
-  Result<nlohmann::json> issue_lease(uint64_t worker, WorkerInfo& w, const UnitChoice& choice);
+  /// Under `mu`: records a lease of the chosen unit and appends it to the log (the job starts with
+  /// its first); the caller hands it out once `ticket` is durable, or ends it (end_lease_id).
+  struct IssuedLease {
+    nlohmann::json body;
+    uint64_t id = 0, ticket = 0;
+  };
+  IssuedLease issue_lease(uint64_t worker, WorkerInfo& w, const UnitChoice& choice);
+  /// Under `mu`: a lease for a worker that asks for one without waiting (with its result), if
+  /// there is work it may take now.
+  std::optional<IssuedLease> next_lease(uint64_t worker);
+  /// Under `mu`: ends lease `id` if it is still in flight.
+  void end_lease_id(uint64_t id) {
+    if (auto it = leases.find(id); it != leases.end()) end_lease(it);
+  }
+  /// Under `mu`: the unit an uploaded result is for, once worker, job and unit check out.
+  Result<size_t> check_result(uint64_t worker, const TileResult& result);
+  /// Under `mu`, once durable (a group-commit callback): the result enters its job, which may then
+  /// be done; `durable` false: the unit is open again.
+  void result_committed(bool durable, uint64_t job, size_t unit, uint64_t worker, TileResult& result, size_t bytes);
+  /// Under `mu`: appends the tile's checkpoint once `min_new` more passes are in its film (encoded
+  /// by the writer, not under `mu`).
+  void checkpoint_tile(JobState& job, uint32_t tile, uint32_t min_new);
+  /// Not under `mu`: waits for a group-commit ticket; the error (500/507) if its batch failed.
+  Status durable(uint64_t ticket);
   /// Under `mu`: a second result for a done unit is dropped, and compared with the first when its
   /// digest was kept (a mismatch is counted and logged as an error).
   void check_duplicate(JobState& job, size_t unit, uint64_t worker, const FilmTile& film);
@@ -102,12 +128,12 @@ struct Coordinator::Impl {
       l = next;
     }
   }
-  /// Under `mu`: the one place a job's phase changes (job_phases.cpp): times, persistence, leases,
-  /// event, image and webhook. Throws (the job unchanged) when the change cannot be persisted, or
-  /// std::logic_error for a transition that does not exist.
-  void change_phase(JobState& job, JobPhase to, const std::string& error = "");
-  /// Under `mu`: persists a job's phase, then finish_job.
-  void save_phase(JobState& job, bool notify = true);
+  /// Under `mu`: the one place a job's phase changes (job_phases.cpp): times, leases, event, image
+  /// and webhook, and the phase appended to the group commit (kept until durable, also across a
+  /// full disk); returns its ticket. Throws std::logic_error for a transition that does not exist.
+  [[nodiscard]] uint64_t change_phase(JobState& job, JobPhase to, const std::string& error = "");
+  /// Under `mu`: appends a job's phase (times, error) to the group commit; its ticket.
+  [[nodiscard]] uint64_t append_phase(const JobState& job);
   /// Under `mu`: a job that ended writes its image, drops its film and (with `notify`) has its
   /// webhook called.
   void finish_job(JobState& job, bool notify);
@@ -132,6 +158,15 @@ struct Coordinator::Impl {
   nlohmann::json run_retention(double now);
   /// Under `mu`: 404 for a job that is not (or no longer) here, saying so if retention deleted it.
   Status missing_job(uint64_t id);
+
+  // The last member: its writer stops (committing what is queued, and running those records'
+  // callbacks under `mu`) before anything it touches is destroyed.
+  GroupCommit commits{store,
+                      [this](const std::function<void()>& callbacks) {
+                        std::lock_guard<std::mutex> lock(mu);
+                        callbacks();
+                      },
+                      std::chrono::microseconds(int64_t(opt.commit_interval * 1e6))};
 };
 
 double wall_seconds();

@@ -93,8 +93,8 @@ Result<json> Coordinator::upload_scene(const std::string& bundle) {
   const std::string hash = sha256_hex(bundle);
   try {
     if (!touch_bundle(s.bundle_path(hash))) write_file_durably(s.bundle_path(hash), bundle);
-    std::lock_guard<std::mutex> lock(s.mu);
     s.store.add_scene(hash, bundle.size(), wall_seconds());
+    std::lock_guard<std::mutex> lock(s.mu);
     s.counters.bytes_in += bundle.size();
   } catch (const std::exception& e) {
     return internal_error(e);
@@ -425,42 +425,37 @@ Result<ImageBytes> Coordinator::job_image(uint64_t id, const std::string& format
 
 Status Coordinator::cancel_job(uint64_t id) {
   Impl& s = *impl_;
-  std::lock_guard<std::mutex> lock(s.mu);
+  std::unique_lock<std::mutex> lock(s.mu);
   auto it = s.jobs.find(id);
   if (it == s.jobs.end()) return unknown_job(id);
   JobState& job = *it->second;
   if (is_terminal(job.phase))
     return make_error(Code::Conflict, "job_finished", "job " + std::to_string(id) + " is already " + phase_name(job.phase));
-  try {
-    s.change_phase(job, JobPhase::Cancelled);
-  } catch (const std::exception& e) {
-    return internal_error(e);
-  }
-  return Status::success();
+  const uint64_t ticket = s.change_phase(job, JobPhase::Cancelled);
+  lock.unlock();
+  return s.durable(ticket);
 }
 
 Status Coordinator::set_priority(uint64_t id, int priority) {
   Impl& s = *impl_;
-  std::lock_guard<std::mutex> lock(s.mu);
+  std::unique_lock<std::mutex> lock(s.mu);
   auto it = s.jobs.find(id);
   if (it == s.jobs.end()) return unknown_job(id);
   if (is_terminal(it->second->phase))
     return make_error(Code::Conflict, "job_finished",
                       "job " + std::to_string(id) + " is " + phase_name(it->second->phase) + "; retry it first");
-  try {
-    s.store.set_job_priority(id, priority);
-  } catch (const std::exception& e) {
-    return internal_error(e);
-  }
   it->second->set_priority(priority);
+  const uint64_t ticket = s.commits.append([id, priority](Store& st) { st.set_job_priority(id, priority); },
+                                           GroupCommit::Retry::UntilDurable);
   log_event(spdlog::level::info, "job.priority", {{"job", id}, {"priority", priority}});
   s.work_cv.notify_all();
-  return Status::success();
+  lock.unlock();
+  return s.durable(ticket);
 }
 
 Status Coordinator::retry_job(uint64_t id) {
   Impl& s = *impl_;
-  std::lock_guard<std::mutex> lock(s.mu);
+  std::unique_lock<std::mutex> lock(s.mu);
   auto it = s.jobs.find(id);
   if (it == s.jobs.end()) return unknown_job(id);
   JobState& old = *it->second;
@@ -472,12 +467,13 @@ Status Coordinator::retry_job(uint64_t id) {
     JobRow row{id, old.name(), to_json(old.plan()).dump(), phase_name(old.phase), old.error, old.priority(),
                old.created(), old.started, old.finished};
     auto job = s.rebuild_job(row);
-    s.change_phase(*job, JobPhase::Queued);
+    const uint64_t ticket = s.change_phase(*job, JobPhase::Queued);
     it->second = std::move(job);
+    lock.unlock();
+    return s.durable(ticket);
   } catch (const std::exception& e) {
     return internal_error(e);
   }
-  return Status::success();
 }
 
 }  // namespace tessera::server

@@ -68,10 +68,10 @@ Result<json> Coordinator::register_worker(const json& body) {
     log_event(spdlog::level::warn, "worker.refused", {{"name", hello.name}, {"reason", mismatch}});
     return make_error(Code::Conflict, "incompatible_worker", mismatch);
   }
-  std::lock_guard<std::mutex> lock(s.mu);
   try {
     WorkerRow row{0, hello.name, hello.version, hello.isa, hello.threads, hello.memory_bytes, wall_seconds()};
-    row.id = s.store.add_worker(row);
+    row.id = s.store.add_worker(row);  // (durable before the id is handed out; not under `mu`)
+    std::lock_guard<std::mutex> lock(s.mu);
     WorkerInfo& w = s.workers[row.id];
     w.row = row;
     w.last_seen = Clock::now();
@@ -111,15 +111,16 @@ std::optional<UnitChoice> Coordinator::Impl::choose_unit_for(uint64_t worker) {
   return choose_unit(candidates, outstanding, worker, opt.speculate);
 }
 
-Result<json> Coordinator::Impl::issue_lease(uint64_t worker, WorkerInfo& w, const UnitChoice& choice) {
+Coordinator::Impl::IssuedLease Coordinator::Impl::issue_lease(uint64_t worker, WorkerInfo& w,
+                                                              const UnitChoice& choice) {
   JobState& job = *jobs.at(choice.job);
   const size_t unit = choice.unit;
   const double now = wall_seconds();
-  // The job's first lease: persisted before anything is recorded in memory, so a failed write
-  // (a full disk) leaves no lease behind that would hold the unit until it expires.
-  if (job.phase == JobPhase::Queued) change_phase(job, JobPhase::Running);
+  IssuedLease issued;
+  // The job's first lease: its phase is logged ahead of the lease.
+  if (job.phase == JobPhase::Queued) (void)change_phase(job, JobPhase::Running);
   Lease l;
-  l.id = store.log_lease(job.id(), job.tile_of(unit), job.pass_of(unit), worker, now);
+  l.id = issued.id = ++last_lease_id;
   l.job_id = job.id();
   l.tile = job.tile_of(unit);
   l.pass = job.pass_of(unit);
@@ -130,11 +131,19 @@ Result<json> Coordinator::Impl::issue_lease(uint64_t worker, WorkerInfo& w, cons
   l.settings = job.plan().settings;
   l.scene_file = job.plan().scene_file;
   l.files = job.plan().files;
+  issued.ticket = commits.append(
+      [=, id = l.id, job_id = l.job_id, tile = l.tile, pass = l.pass](Store& st) {
+        st.log_lease(id, job_id, tile, pass, worker, now);
+      },
+      GroupCommit::Retry::No,
+      [this, id = l.id](bool durable) {
+        if (!durable) end_lease_id(id);  // not logged: never handed out
+      });
   job.lease_started(unit);
   leases[l.id] = LeaseInfo{l.id, l.job_id, worker, unit, Clock::now() + dead_after()};
   set_worker_state(worker, w, WorkerState::Busy);
-  json j = to_json(l);
-  const size_t bytes = j.dump().size();
+  issued.body = to_json(l);
+  const size_t bytes = issued.body.dump().size();
   job.lease_bytes += bytes;
   counters.bytes_out += bytes;
   ++counters.leased;
@@ -142,7 +151,7 @@ Result<json> Coordinator::Impl::issue_lease(uint64_t worker, WorkerInfo& w, cons
   log_event(spdlog::level::debug, "lease.issued",
             {{"lease", l.id}, {"job", l.job_id}, {"tile", l.tile}, {"pass", l.pass}, {"worker", worker},
              {"speculative", choice.speculative}});
-  return j;
+  return issued;
 }
 
 Result<json> Coordinator::lease(uint64_t worker, double wait_seconds) {
@@ -167,14 +176,11 @@ Result<json> Coordinator::lease(uint64_t worker, double wait_seconds) {
     if (w->state == WorkerState::Draining)
       return make_error(Code::Gone, "drained", "worker " + std::to_string(worker) + " is being drained: no more work");
     if (std::optional<UnitChoice> choice = s.choose_unit_for(worker)) {
-      Result<json> issued = make_error(Code::Internal, "internal", "no lease");
-      try {
-        issued = s.issue_lease(worker, *w, *choice);
-      } catch (const std::exception& e) {
-        return internal_error(e);
-      }
+      Impl::IssuedLease issued = s.issue_lease(worker, *w, *choice);
+      lock.unlock();
+      if (Status st = s.durable(issued.ticket); !st.ok()) return st;  // (its callback ended it)
       s.lease_wait.observe(std::chrono::duration<double>(Clock::now() - t0).count());
-      return issued;
+      return std::move(issued.body);
     }
     if (Clock::now() >= deadline) break;
     s.update_busy(worker, *w);  // waiting for work with none in hand: idle, as the dashboard shows
@@ -224,19 +230,12 @@ bool Coordinator::Impl::keep_lease(uint64_t worker, const HeldLease& held) {
   return true;
 }
 
-Result<json> Coordinator::upload_result(uint64_t worker, uint64_t lease, std::string_view bytes) {
-  Impl& s = *impl_;
-  const auto t0 = Clock::now();
-  TileResult result;
-  std::string error;
-  if (!decode_tile_result(bytes, result, error, s.opt.limits.max_pixels))
-    return make_error(Code::BadRequest, "bad_result", error);
-  std::lock_guard<std::mutex> lock(s.mu);
-  WorkerInfo* w = s.find_worker(worker);
+Result<size_t> Coordinator::Impl::check_result(uint64_t worker, const TileResult& result) {
+  WorkerInfo* w = find_worker(worker);
   if (!w) return unknown_worker(worker);
-  s.saw_worker(worker, *w);
-  auto it = s.jobs.find(result.job_id);
-  if (it == s.jobs.end()) return unknown_job(result.job_id);
+  saw_worker(worker, *w);
+  auto it = jobs.find(result.job_id);
+  if (it == jobs.end()) return unknown_job(result.job_id);
   JobState& job = *it->second;
   if (job.phase == JobPhase::Cancelled || job.phase == JobPhase::Failed)
     return make_error(Code::Gone, "job_ended", "job " + std::to_string(job.id()) + " is " + phase_name(job.phase));
@@ -246,41 +245,102 @@ Result<json> Coordinator::upload_result(uint64_t worker, uint64_t lease, std::st
   if (!(result.film.rect() == job.rect(unit)) || result.sample_begin != job.sample_begin(unit) ||
       result.sample_end != job.sample_end(unit))
     return make_error(Code::BadRequest, "bad_result", "the result's rectangle or samples do not match the unit");
-  s.end_leases_if([&](const LeaseInfo& l) { return l.job == job.id() && l.unit == unit && l.worker == worker; });
-  if (job.is_done(unit)) {
-    s.check_duplicate(job, unit, worker, result.film);
-    return json{{"accepted", false}, {"duplicate", true}};
-  }
-  try {
-    // Durable before it is acknowledged: the commit fsyncs the WAL.
-    if (!s.store.add_result(job.id(), result.tile, result.pass, worker, std::string(bytes), wall_seconds())) {
-      ++job.duplicates;
-      return json{{"accepted", false}, {"duplicate", true}};
-    }
-  } catch (const std::exception& e) {
-    return internal_error(e);
+  return unit;
+}
+
+void Coordinator::Impl::result_committed(bool durable, uint64_t job_id, size_t unit, uint64_t worker,
+                                         TileResult& result, size_t bytes) {
+  auto it = jobs.find(job_id);
+  if (it == jobs.end()) return;
+  JobState& job = *it->second;
+  if (!durable) {  // not acknowledged: the unit is open again
+    job.commit_failed(unit);
+    work_cv.notify_all();
+    return;
   }
   const uint64_t samples = job.unit_samples(unit);
-  // Another copy is still being rendered (speculative, or re-issued from a worker thought dead):
-  // its result will be checked against this one.
-  if (job.active_leases(unit) > 0) job.remember_digest(unit, tile_digest(result.film));
-  (void)job.add_result(unit, std::move(result.film), worker);
-  job.result_bytes += bytes.size();
-  ++s.counters.done;
+  if (!job.add_result(unit, std::move(result.film), worker)) return;  // (a retry rebuilt it meanwhile)
+  checkpoint_tile(job, job.tile_of(unit), 1);
+  job.result_bytes += bytes;
+  ++counters.done;
+  counters.bytes_in += bytes;
+  if (WorkerInfo* w = find_worker(worker)) {
+    w->units_done += 1;
+    w->samples_done += samples;
+    w->render_seconds += result.seconds;
+  }
   log_event(spdlog::level::debug, "lease.done",
-            {{"lease", lease}, {"job", job.id()}, {"unit", unit}, {"worker", worker}, {"seconds", result.seconds}});
-  s.counters.bytes_in += bytes.size();
-  w->units_done += 1;
-  w->samples_done += samples;
-  w->render_seconds += result.seconds;
-  if (job.complete()) try {
-      s.change_phase(job, JobPhase::Done);
-    } catch (const std::exception& e) {
-      return internal_error(e);
+            {{"job", job.id()}, {"unit", unit}, {"worker", worker}, {"seconds", result.seconds}});
+  // (The phase is kept until durable; a crash before that finds the job complete at start-up.)
+  if (!is_terminal(job.phase) && job.complete()) (void)change_phase(job, JobPhase::Done);
+}
+
+std::optional<Coordinator::Impl::IssuedLease> Coordinator::Impl::next_lease(uint64_t worker) {
+  WorkerInfo* w = find_worker(worker);
+  if (stopping || !w || w->state == WorkerState::Draining) return std::nullopt;
+  std::optional<UnitChoice> choice = choose_unit_for(worker);
+  if (!choice) return std::nullopt;
+  return issue_lease(worker, *w, *choice);
+}
+
+Result<json> Coordinator::upload_result(uint64_t worker, uint64_t /*lease*/, std::string_view bytes, bool next) {
+  Impl& s = *impl_;
+  const auto t0 = Clock::now();
+  auto result = std::make_shared<TileResult>();
+  std::string error;
+  if (!decode_tile_result(bytes, *result, error, s.opt.limits.max_pixels))
+    return make_error(Code::BadRequest, "bad_result", error);
+  // Decided here and appended to the group commit; its callback adds it to the job once durable.
+  uint64_t ticket = 0;
+  bool duplicate = false;
+  std::optional<Impl::IssuedLease> issued;
+  {
+    std::lock_guard<std::mutex> lock(s.mu);
+    Result<size_t> checked = s.check_result(worker, *result);
+    if (!checked.ok()) return checked.status;
+    const size_t unit = checked.value;
+    JobState& job = *s.jobs.at(result->job_id);
+    s.end_leases_if([&](const LeaseInfo& l) { return l.job == job.id() && l.unit == unit && l.worker == worker; });
+    if (job.is_done(unit) && job.accepted_from(unit) == worker) {
+      // The same worker again: a retry of an upload whose answer was lost (the coordinator
+      // restarted, or the connection broke), not a second render. Answered as it was the first time.
+      if (next) issued = s.next_lease(worker);
+      if (!issued) return json{{"accepted", true}, {"duplicate", false}, {"lease", nullptr}};
+      ticket = issued->ticket;
+    } else if (job.is_done(unit) || job.is_committing(unit)) {
+      s.check_duplicate(job, unit, worker, result->film);
+      duplicate = true;
+      if (next) issued = s.next_lease(worker);
+      if (!issued) return json{{"accepted", false}, {"duplicate", true}, {"lease", nullptr}};
+      ticket = issued->ticket;
+    } else {
+      job.start_commit(unit);
+      // Another copy is still being rendered (speculative, or re-issued from a worker thought dead):
+      // its result will be checked against this one.
+      if (job.active_leases(unit) > 0) job.remember_digest(unit, tile_digest(result->film));
+      ticket = s.commits.append(
+          [job = job.id(), tile = result->tile, pass = result->pass, worker, data = std::string(bytes),
+           now = wall_seconds()](Store& st) { (void)st.add_result(job, tile, pass, worker, data, now); },
+          GroupCommit::Retry::No,
+          [&s, job = job.id(), unit, worker, result, n = bytes.size()](bool durable) {
+            s.result_committed(durable, job, unit, worker, *result, n);
+          });
+      if (next) issued = s.next_lease(worker);  // (logged after the result: one commit for both)
     }
-  (void)lease;
+  }
+  if (Status st = s.durable(ticket); !st.ok()) {
+    if (issued) {  // (its own batch may have committed: the worker will not get it, so it ends)
+      std::lock_guard<std::mutex> lock(s.mu);
+      s.end_lease_id(issued->id);
+    }
+    return st;
+  }
+  if (issued && !duplicate)
+    if (Status st = s.durable(issued->ticket); !st.ok()) return st;
   s.upload_seconds.observe(std::chrono::duration<double>(Clock::now() - t0).count());
-  return json{{"accepted", true}, {"duplicate", false}};
+  json reply = {{"accepted", !duplicate}, {"duplicate", duplicate}};
+  if (next) reply["lease"] = issued ? std::move(issued->body) : json(nullptr);
+  return reply;
 }
 
 void Coordinator::Impl::check_duplicate(JobState& job, size_t unit, uint64_t worker, const FilmTile& film) {
@@ -297,7 +357,10 @@ void Coordinator::Impl::check_duplicate(JobState& job, size_t unit, uint64_t wor
 
 Status Coordinator::fail_lease(uint64_t worker, uint64_t lease, const json& body) {
   Impl& s = *impl_;
-  std::lock_guard<std::mutex> lock(s.mu);
+  std::string reason = body.is_object() && body.contains("error") && body["error"].is_string()
+                           ? body["error"].get<std::string>().substr(0, 2000)
+                           : "unspecified";
+  std::unique_lock<std::mutex> lock(s.mu);
   auto it = s.leases.find(lease);
   if (it == s.leases.end() || it->second.worker != worker)
     return make_error(Code::NotFound, "unknown_lease", "worker " + std::to_string(worker) + " holds no lease " +
@@ -306,9 +369,6 @@ Status Coordinator::fail_lease(uint64_t worker, uint64_t lease, const json& body
   s.end_lease(it);
   if (job_it == s.jobs.end()) return Status::success();
   JobState& job = *job_it->second;
-  std::string reason = body.is_object() && body.contains("error") && body["error"].is_string()
-                           ? body["error"].get<std::string>().substr(0, 2000)
-                           : "unspecified";
   ++job.failures_by_worker[worker];
   ++s.counters.failed;
   job.last_failure = reason;
@@ -317,29 +377,29 @@ Status Coordinator::fail_lease(uint64_t worker, uint64_t lease, const json& body
   size_t live = 0;
   for (auto& [id, w] : s.workers) live += is_live(w.state);
   const size_t needed = std::max<size_t>(1, std::min<size_t>(size_t(s.opt.failed_workers_limit), live));
-  if (!is_terminal(job.phase) && job.failures_by_worker.size() >= needed) try {
-      s.change_phase(job, JobPhase::Failed,
-                     "failed on " + std::to_string(job.failures_by_worker.size()) + " worker(s); last error: " + reason);
-    } catch (const std::exception& e) {
-      return internal_error(e);
-    }
-  return Status::success();
+  if (is_terminal(job.phase) || job.failures_by_worker.size() < needed) return Status::success();
+  const uint64_t ticket = s.change_phase(job, JobPhase::Failed,
+                                         "failed on " + std::to_string(job.failures_by_worker.size()) +
+                                             " worker(s); last error: " + reason);
+  lock.unlock();
+  return s.durable(ticket);
 }
 
 Status Coordinator::sign_off(uint64_t worker, const json& body) {
   Impl& s = *impl_;
-  std::lock_guard<std::mutex> lock(s.mu);
-  WorkerInfo* w = s.find_worker(worker);
-  if (!w) return unknown_worker(worker);
-  s.end_leases_if([&](const LeaseInfo& l) { return l.worker == worker; });
-  s.set_worker_state(worker, *w, WorkerState::Gone);
-  try {
-    s.store.touch_worker(worker, wall_seconds(), "gone");
-  } catch (const std::exception& e) {
-    return internal_error(e);
+  uint64_t ticket = 0;
+  {
+    std::lock_guard<std::mutex> lock(s.mu);
+    WorkerInfo* w = s.find_worker(worker);
+    if (!w) return unknown_worker(worker);
+    s.end_leases_if([&](const LeaseInfo& l) { return l.worker == worker; });
+    s.set_worker_state(worker, *w, WorkerState::Gone);
+    ticket = s.commits.append([worker, now = wall_seconds()](Store& st) { st.touch_worker(worker, now, "gone"); },
+                              GroupCommit::Retry::UntilDurable);
+    log_event(spdlog::level::info, "worker.signed_off", {{"worker", worker}});
   }
-  log_event(spdlog::level::info, "worker.signed_off", {{"worker", worker}});
-  return Status::success();
+  (void)body;
+  return s.durable(ticket);
 }
 
 Status Coordinator::drain_worker(uint64_t worker) {

@@ -6,8 +6,10 @@
 //   Queued/Running -> Cancelled       a client cancelled it
 //   Failed/Cancelled -> Queued        a client retried it (keeping the passes it has)
 //
-// Each change sets the job's times, is persisted before it is visible, ends the job's leases when
-// it ends, and is logged; an ended job's image is written and its webhook called (save_phase).
+// Each change sets the job's times, is appended to the group commit (in the order of the leases and
+// results around it; kept until durable, so a full disk delays it but never loses it), ends the
+// job's leases when it ends, and is logged; an ended job's image is written and its webhook called
+// (finish_job).
 #include "coordinator_impl.h"
 #include "event_log.h"
 
@@ -46,13 +48,10 @@ void log_change(const JobState& job, JobPhase to) {
 
 }  // namespace
 
-void Coordinator::Impl::change_phase(JobState& job, JobPhase to, const std::string& error) {
+uint64_t Coordinator::Impl::change_phase(JobState& job, JobPhase to, const std::string& error) {
   if (!allowed(job.phase, to))
     throw std::logic_error(std::string("job ") + std::to_string(job.id()) + ": no transition from " +
                            phase_name(job.phase) + " to " + phase_name(to));
-  const JobPhase from = job.phase;
-  const double started = job.started, finished = job.finished;
-  const std::string old_error = job.error;
   const double now = wall_seconds();
   job.phase = to;
   if (to == JobPhase::Running) job.started = now;
@@ -62,21 +61,25 @@ void Coordinator::Impl::change_phase(JobState& job, JobPhase to, const std::stri
     job.finished = 0;
     job.error.clear();
   }
-  try {
-    store.set_job_state(job.id(), phase_name(job.phase), job.error, job.started, job.finished);
-  } catch (...) {  // not persisted: as if it had not happened (a full disk; the client retries)
-    job.phase = from;
-    job.started = started;
-    job.finished = finished;
-    job.error = old_error;
-    throw;
-  }
+  const uint64_t ticket = append_phase(job);
   if (is_terminal(to)) end_leases_if([&](const LeaseInfo& l) { return l.job == job.id(); });
   log_change(job, to);
   work_cv.notify_all();
   // (A full disk can stop the image here: the job has ended all the same, and the retention pass
   // writes the image later from the film it keeps until then.)
-  if (is_terminal(to)) finish_job(job, /*notify=*/true);
+  if (is_terminal(to)) try {
+      finish_job(job, /*notify=*/true);
+    } catch (const std::exception& e) {
+      spdlog::warn("job {}: image not written yet: {}", job.id(), e.what());
+    }
+  return ticket;
+}
+
+uint64_t Coordinator::Impl::append_phase(const JobState& job) {
+  return commits.append(
+      [id = job.id(), phase = std::string(phase_name(job.phase)), error = job.error, started = job.started,
+       finished = job.finished](Store& st) { st.set_job_state(id, phase, error, started, finished); },
+      GroupCommit::Retry::UntilDurable);
 }
 
 }  // namespace tessera::server

@@ -38,7 +38,10 @@ JobState::JobState(uint64_t id, JobPlan plan, std::string name, int priority, do
   }
   done_.assign(num_units(), 0);
   active_leases_.assign(num_units(), 0);
+  accepted_from_.assign(num_units(), 0);
   next_pass_.assign(tiles_.size(), 0);
+  folded_.assign(tiles_.size(), 0);
+  tile_counters_.assign(tiles_.size(), RenderCounters{});
   total_samples_ = uint64_t(plan_.window.area()) * uint64_t(plan_.settings.spp);
   pass_done_.assign(passes_.size(), 0);
   open_passes_ = plan_.settings.target_error > 0 ? std::min<size_t>(1, passes_.size()) : passes_.size();
@@ -63,7 +66,7 @@ void JobState::advance_passes() {
   while (!converged_ && open_passes_ < passes_.size() && complete_passes_ >= open_passes_) {
     // A unit of the next pass is done already: the decision to go on was taken before a restart.
     bool decided = false;
-    for (size_t t = 0; t < tiles_.size() && !decided; ++t) decided = done_[unit(uint32_t(t), uint32_t(open_passes_))];
+    for (size_t t = 0; t < tiles_.size() && !decided; ++t) decided = is_done(unit(uint32_t(t), uint32_t(open_passes_)));
     if (!decided && film_ && noise().rel_mse <= plan_.settings.target_error) {
       converged_ = true;
       break;
@@ -76,7 +79,7 @@ std::optional<size_t> JobState::next_unit() const {
   if (converged_) return std::nullopt;
   const size_t open_end = open_passes_ * tiles_.size();
   for (size_t u = first_open_; u < open_end; ++u)
-    if (!done_[u] && active_leases_[u] == 0) return u;
+    if (done_[u] == kOpen && active_leases_[u] == 0) return u;
   return std::nullopt;
 }
 
@@ -85,18 +88,19 @@ void JobState::lease_ended(size_t unit) {
 }
 
 void JobState::mark_done(size_t unit, uint64_t worker) {
-  if (done_[unit]) return;
-  done_[unit] = 1;
+  if (done_[unit] == kDone) return;
+  done_[unit] = kDone;
+  accepted_from_[unit] = worker;
   ++done_units_;
   ++pass_done_[pass_of(unit)];
   done_samples_ += unit_samples(unit);
   samples_by_worker_[worker] += unit_samples(unit);
-  while (first_open_ < done_.size() && done_[first_open_]) ++first_open_;
+  while (first_open_ < done_.size() && done_[first_open_] == kDone) ++first_open_;
   while (complete_passes_ < passes_.size() && pass_done_[complete_passes_] == tiles_.size()) ++complete_passes_;
 }
 
 bool JobState::add_result(size_t unit, FilmTile&& tile, uint64_t worker) {
-  if (done_[unit]) {
+  if (done_[unit] == kDone) {
     ++duplicates;
     return false;
   }
@@ -110,11 +114,37 @@ bool JobState::add_result(size_t unit, FilmTile&& tile, uint64_t worker) {
   for (auto it = waiting_.find(this->unit(t, next_pass_[t])); it != waiting_.end();
        it = waiting_.find(this->unit(t, next_pass_[t]))) {
     if (film_) film_->add_tile(it->second);
+    tile_counters_[t] += it->second.counters;
     waiting_.erase(it);
     if (++next_pass_[t] == passes_.size()) break;
   }
   advance_passes();
   return true;
+}
+
+std::optional<JobState::Checkpoint> JobState::take_checkpoint(uint32_t t, uint32_t min_new) {
+  if (!film_ || next_pass_[t] < folded_[t] + std::max<uint32_t>(1, min_new)) return std::nullopt;
+  Checkpoint cp;
+  cp.tile = t;
+  cp.from = folded_[t];
+  cp.passes = next_pass_[t];
+  cp.sample_end = sample_end(unit(t, cp.passes - 1));
+  const TileRect& r = tiles_[t];
+  cp.sums.reset(r);
+  std::vector<PixelSums>& out = cp.sums.mutable_pixels();
+  for (int y = r.y0; y < r.y1; ++y)
+    for (int x = r.x0; x < r.x1; ++x) out[size_t(y - r.y0) * size_t(r.width()) + size_t(x - r.x0)] = film_->pixel({x, y});
+  cp.sums.counters = tile_counters_[t];
+  folded_[t] = cp.passes;
+  return cp;
+}
+
+void JobState::restore_checkpoint(uint32_t t, uint32_t passes, FilmTile&& sums) {
+  if (!film_ && !film_released_) film_ = std::make_unique<Film>(plan_.window, plan_.full_width, plan_.full_height);
+  if (film_) film_->add_tile(sums);
+  counters_ += sums.counters;
+  tile_counters_[t] = sums.counters;
+  next_pass_[t] = folded_[t] = passes;
 }
 
 }  // namespace tessera::server

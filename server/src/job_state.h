@@ -8,6 +8,7 @@
 #include "tessera/render/film.h"
 #include "tessera/render/noise_estimate.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -71,7 +72,17 @@ class JobState {
   /// Leases of the unit in flight.
   unsigned active_leases(size_t unit) const { return active_leases_[unit]; }
   void lease_ended(size_t unit);
-  bool is_done(size_t unit) const { return done_[unit]; }
+  bool is_done(size_t unit) const { return done_[unit] == kDone; }
+  /// The worker whose result of a done unit was accepted.
+  uint64_t accepted_from(size_t unit) const { return accepted_from_[unit]; }
+  /// A result for the unit is being committed: it is not leased again meanwhile, and a second
+  /// result is a duplicate. Ended by add_result, or by commit_failed (the unit is open again).
+  bool is_committing(size_t unit) const { return done_[unit] == kCommitting; }
+  void start_commit(size_t unit) { done_[unit] = kCommitting; }
+  void commit_failed(size_t unit) {
+    if (done_[unit] == kCommitting) done_[unit] = kOpen;
+    digests_.erase(unit);
+  }
   /// The digest of a unit's accepted sums, kept when another copy of it was in flight (also once
   /// the job has ended: that copy's result may still arrive).
   void remember_digest(size_t unit, const Sha256Digest& d) { digests_[unit] = d; }
@@ -81,8 +92,26 @@ class JobState {
   }
   /// Adds a verified result; false when the unit was already done (a duplicate).
   bool add_result(size_t unit, FilmTile&& tile, uint64_t worker);
-  /// Marks a unit done without its sums (a finished job resumed from its stored image).
+  /// Marks a unit done without its sums (a finished job resumed from its stored image, or a pass a
+  /// tile's checkpoint holds).
   void mark_done(size_t unit, uint64_t worker);
+
+  // Checkpoints: a tile's sums over its passes 0..passes-1 (the film's region, which holds them in
+  // pass order), stored in place of those passes' results. Taken as passes enter the film; a job is
+  // rebuilt from its checkpoints and the results after them, bit for bit, since adding a tile's sums
+  // to a zero film reproduces them exactly.
+  struct Checkpoint {
+    uint32_t tile = 0, from = 0, passes = 0;  // results of passes from..passes-1 become redundant
+    uint32_t sample_end = 0;                 // samples per pixel it holds
+    FilmTile sums;                           // (with the counters of those passes)
+  };
+  /// The tile's checkpoint once at least `min_new` passes entered the film since the last one.
+  std::optional<Checkpoint> take_checkpoint(uint32_t tile, uint32_t min_new);
+  /// The checkpoint was not stored: its passes are checkpointed again next time.
+  void checkpoint_failed(uint32_t tile, uint32_t from) { folded_[tile] = std::min(folded_[tile], from); }
+  /// Rebuilding: the tile's sums over its first `passes` passes (their units are marked done from
+  /// their rows, before or after).
+  void restore_checkpoint(uint32_t tile, uint32_t passes, FilmTile&& sums);
 
   /// Mean radiance over the film window (zero where no pass has arrived). Only with has_film().
   Image image() const;
@@ -125,9 +154,13 @@ class JobState {
   double created_;
   std::vector<TileRect> tiles_;
   std::vector<uint32_t> passes_, pass_begin_;
-  std::vector<uint8_t> done_;
+  enum : uint8_t { kOpen, kDone, kCommitting };
+  std::vector<uint8_t> done_;  // per unit: kOpen, kDone or kCommitting
   std::vector<uint16_t> active_leases_;
+  std::vector<uint64_t> accepted_from_;  // per done unit: the worker its result came from
   std::vector<uint32_t> next_pass_;              // per tile: passes already in the film
+  std::vector<uint32_t> folded_;                 // per tile: passes in its checkpoint
+  std::vector<RenderCounters> tile_counters_;    // per tile: counters of the passes in the film
   std::map<size_t, FilmTile> waiting_;           // results that arrived before an earlier pass
   std::map<size_t, Sha256Digest> digests_;       // see remember_digest
   void advance_passes();

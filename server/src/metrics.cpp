@@ -17,6 +17,7 @@ Histogram::Histogram(std::vector<double> upper_bounds) : bounds_(std::move(upper
 
 void Histogram::observe(double value) {
   const size_t i = size_t(std::lower_bound(bounds_.begin(), bounds_.end(), value) - bounds_.begin());
+  std::lock_guard<std::mutex> lock(mu_);
   ++counts_[i];
   sum_ += value;
   ++count_;
@@ -24,6 +25,7 @@ void Histogram::observe(double value) {
 
 std::string Histogram::render(const std::string& name, const std::string& help) const {
   std::string out = metric_header(name, "histogram", help);
+  std::lock_guard<std::mutex> lock(mu_);
   uint64_t cumulative = 0;
   for (size_t i = 0; i < bounds_.size(); ++i) {
     cumulative += counts_[i];

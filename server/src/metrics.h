@@ -2,11 +2,13 @@
 #pragma once
 
 #include <cstdint>
+#include <mutex>
 #include <string>
 #include <vector>
 
 namespace tessera::server {
 
+/// Thread-safe: requests observe it after they have released the coordinator's lock.
 class Histogram {
  public:
   explicit Histogram(std::vector<double> upper_bounds);
@@ -15,6 +17,7 @@ class Histogram {
   std::string render(const std::string& name, const std::string& help) const;
 
  private:
+  mutable std::mutex mu_;
   std::vector<double> bounds_;
   std::vector<uint64_t> counts_;  // per bucket, not cumulative; one more for +Inf
   double sum_ = 0;

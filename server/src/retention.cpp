@@ -84,7 +84,7 @@ json Coordinator::Impl::run_retention(double now) {
     // Images a full disk kept from being written: the job ended, its film is still in memory.
     for (auto& [id, job] : jobs)
       if (is_terminal(job->phase) && job->has_film()) try {
-          save_phase(*job);
+          finish_job(*job, /*notify=*/true);
           log_event(spdlog::level::info, "job.image_saved", {{"job", id}});
         } catch (const std::exception& e) {
           spdlog::warn("job {}: image still not written: {}", id, e.what());

@@ -24,6 +24,10 @@ int parse_server_args(int argc, char** argv, ServerOptions& o) {
                "never lease a second copy of an outstanding unit to an idle worker (each unit is leased once)");
   app.add_option("--max-poll-wait", c.max_poll_wait, "longest lease long poll, seconds")
       ->check(CLI::Range(0.0, 30.0))->capture_default_str();
+  app.add_option("--commit-interval", c.commit_interval,
+                 "seconds: under load, the state database commits (one fsync) at most this often, every lease "
+                 "and result decided meanwhile together; 0 commits as soon as the previous commit ends")
+      ->check(CLI::Range(0.0, 0.1))->capture_default_str();
 
   auto* security = "Security";
   app.add_option("--client-token", o.client_token, "bearer token for clients (else $TESSERA_CLIENT_TOKEN)")->group(security);

@@ -2,7 +2,9 @@
 
 #include <sqlite3.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cstring>
 #include <filesystem>
 
 namespace tessera::server {
@@ -22,6 +24,8 @@ CREATE INDEX IF NOT EXISTS leases_by_unit ON leases(job, pass, tile);
 CREATE TABLE IF NOT EXISTS workers(id INTEGER PRIMARY KEY AUTOINCREMENT, name TEXT NOT NULL, threads INTEGER NOT NULL,
   memory INTEGER NOT NULL, version TEXT NOT NULL, isa TEXT NOT NULL, registered REAL NOT NULL,
   last_seen REAL NOT NULL, state TEXT NOT NULL);
+CREATE TABLE IF NOT EXISTS checkpoints(job INTEGER NOT NULL, tile INTEGER NOT NULL, passes INTEGER NOT NULL,
+  data BLOB NOT NULL, PRIMARY KEY(job, tile));
 CREATE TABLE IF NOT EXISTS expired_jobs(id INTEGER PRIMARY KEY, name TEXT NOT NULL, expired REAL NOT NULL);
 )";
 
@@ -76,6 +80,11 @@ class Stmt {
     fail(db_, "step");
   }
   bool constraint() const { return constraint_; }
+  /// Ready to bind and step again.
+  void reset() {
+    sqlite3_reset(stmt_);
+    n_ = 0;
+  }
   int64_t i(int col) const { return sqlite3_column_int64(stmt_, col); }
   double d(int col) const { return sqlite3_column_double(stmt_, col); }
   std::string s(int col) const {
@@ -96,47 +105,80 @@ class Stmt {
 
 }  // namespace
 
-Store::Store(const std::string& path) {
-  if (sqlite3_open_v2(path.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX,
-                      nullptr) != SQLITE_OK) {
-    std::string msg = "cannot open the state database " + path;
-    sqlite3_close(db_);
-    db_ = nullptr;
-    throw StoreError(msg, false);
+namespace {
+sqlite3* open_connection(const std::string& path, int flags) {
+  sqlite3* db = nullptr;
+  if (sqlite3_open_v2(path.c_str(), &db, flags | SQLITE_OPEN_FULLMUTEX, nullptr) != SQLITE_OK) {
+    sqlite3_close(db);
+    throw StoreError("cannot open the state database " + path, false);
   }
-  sqlite3_busy_timeout(db_, 5000);
-  // Only takes effect in a new database (before its first table): pages freed by retention then
-  // go back to the file system at incremental_vacuum(). Older databases reuse them instead.
-  exec("PRAGMA auto_vacuum=INCREMENTAL");
-  // WAL keeps readers off the writer's back; FULL fsyncs the log at every commit, which is what
-  // makes an acknowledged result survive a crash.
-  exec("PRAGMA journal_mode=WAL");
-  exec("PRAGMA synchronous=FULL");
-  exec(kSchema);
+  sqlite3_busy_timeout(db, 5000);
+  return db;
+}
+}  // namespace
+
+Store::Store(const std::string& path) {
+  db_ = open_connection(path, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
+  try {
+    // Only takes effect in a new database (before its first table): pages freed by retention then
+    // go back to the file system at incremental_vacuum(). Older databases reuse them instead. Set
+    // only then: on an existing database the pragma writes, which fails on a full disk.
+    if (!Stmt(db_, "SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = 'jobs'").step())
+      exec("PRAGMA auto_vacuum=INCREMENTAL");
+    // WAL keeps readers off the writer's back; FULL fsyncs the log at every commit, which is what
+    // makes an acknowledged result survive a crash.
+    exec("PRAGMA journal_mode=WAL");
+    exec("PRAGMA synchronous=FULL");
+    exec(kSchema);
+    // Reads get a connection of their own: they see committed data only, never a batch that the
+    // writer has open, and never wait for its fsync.
+    rd_ = open_connection(path, SQLITE_OPEN_READONLY);
+  } catch (...) {
+    sqlite3_close(db_);
+    throw;
+  }
 }
 
-Store::~Store() { sqlite3_close(db_); }
+Store::~Store() {
+  sqlite3_close(rd_);
+  sqlite3_close(db_);
+}
+
+void Store::transaction(const std::function<void()>& writes) {
+  WriteLock lock(write_mu_);
+  exec("BEGIN IMMEDIATE");
+  try {
+    writes();
+    exec("COMMIT");
+  } catch (...) {
+    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+    throw;
+  }
+}
 
 void Store::exec(const char* sql) {
   char* err = nullptr;
   if (sqlite3_exec(db_, sql, nullptr, nullptr, &err) != SQLITE_OK) {
     std::string msg = err ? err : "error";
     sqlite3_free(err);
-    throw_error(db_, "state database: " + msg);
+    const std::string statement(sql, std::min<size_t>(std::strlen(sql), 40));
+    throw_error(db_, "state database: " + msg + " (at " + statement + (std::strlen(sql) > 40 ? "...)" : ")"));
   }
 }
 
 void Store::add_scene(const std::string& hash, uint64_t bytes, double now) {
+  WriteLock lock(write_mu_);
   Stmt st(db_, "INSERT OR IGNORE INTO scenes(hash, bytes, created) VALUES(?, ?, ?)");
   st.bind(hash).bind(int64_t(bytes)).bind(now).step();
 }
 
 bool Store::has_scene(const std::string& hash) {
-  Stmt st(db_, "SELECT 1 FROM scenes WHERE hash = ?");
+  Stmt st(rd_, "SELECT 1 FROM scenes WHERE hash = ?");
   return st.bind(hash).step();
 }
 
 uint64_t Store::add_job(const std::string& name, const std::string& plan_json, int priority, double now) {
+  WriteLock lock(write_mu_);
   Stmt st(db_, "INSERT INTO jobs(name, plan, priority, state, created) VALUES(?, ?, ?, 'queued', ?)");
   st.bind(name).bind(plan_json).bind(int64_t(priority)).bind(now).step();
   return uint64_t(sqlite3_last_insert_rowid(db_));
@@ -144,31 +186,42 @@ uint64_t Store::add_job(const std::string& name, const std::string& plan_json, i
 
 void Store::set_job_state(uint64_t id, const std::string& state, const std::string& error, double started,
                           double finished) {
+  WriteLock lock(write_mu_);
   Stmt st(db_, "UPDATE jobs SET state = ?, error = ?, started = ?, finished = ? WHERE id = ?");
   st.bind(state).bind(error).bind(started).bind(finished).bind(int64_t(id)).step();
 }
 
 void Store::set_job_priority(uint64_t id, int priority) {
+  WriteLock lock(write_mu_);
   Stmt st(db_, "UPDATE jobs SET priority = ? WHERE id = ?");
   st.bind(int64_t(priority)).bind(int64_t(id)).step();
 }
 
 std::vector<JobRow> Store::jobs() {
-  Stmt st(db_, "SELECT id, name, plan, priority, state, error, created, started, finished FROM jobs ORDER BY id");
+  Stmt st(rd_, "SELECT id, name, plan, priority, state, error, created, started, finished FROM jobs ORDER BY id");
   std::vector<JobRow> rows;
   while (st.step())
     rows.push_back({uint64_t(st.i(0)), st.s(1), st.s(2), st.s(4), st.s(5), int(st.i(3)), st.d(6), st.d(7), st.d(8)});
   return rows;
 }
 
-uint64_t Store::log_lease(uint64_t job, uint32_t tile, uint32_t pass, uint64_t worker, double now) {
-  Stmt st(db_, "INSERT INTO leases(job, tile, pass, worker, issued) VALUES(?, ?, ?, ?, ?)");
-  st.bind(int64_t(job)).bind(int64_t(tile)).bind(int64_t(pass)).bind(int64_t(worker)).bind(now).step();
-  return uint64_t(sqlite3_last_insert_rowid(db_));
+void Store::log_lease(uint64_t seq, uint64_t job, uint32_t tile, uint32_t pass, uint64_t worker, double now) {
+  WriteLock lock(write_mu_);
+  Stmt st(db_, "INSERT INTO leases(seq, job, tile, pass, worker, issued) VALUES(?, ?, ?, ?, ?, ?)");
+  st.bind(int64_t(seq)).bind(int64_t(job)).bind(int64_t(tile)).bind(int64_t(pass)).bind(int64_t(worker)).bind(now);
+  if (!st.step() && st.constraint()) fail(db_, "lease " + std::to_string(seq) + " logged twice");
+}
+
+uint64_t Store::last_lease_seq() {
+  // AUTOINCREMENT's counter: never lowered, also once retention has deleted the newest leases.
+  Stmt st(rd_, "SELECT COALESCE((SELECT seq FROM sqlite_sequence WHERE name = 'leases'), 0)");
+  st.step();
+  return uint64_t(st.i(0));
 }
 
 bool Store::add_result(uint64_t job, uint32_t tile, uint32_t pass, uint64_t worker, const std::string& data,
                        double now) {
+  WriteLock lock(write_mu_);
   // ack_seq: the newest lease at acknowledgement; any lease for this pass with a larger sequence
   // number was issued after the pass was safe (reissued_after_ack).
   Stmt st(db_,
@@ -179,15 +232,33 @@ bool Store::add_result(uint64_t job, uint32_t tile, uint32_t pass, uint64_t work
   return !st.constraint();
 }
 
+void Store::save_checkpoint(uint64_t job, uint32_t tile, uint32_t from, uint32_t passes, const std::string& data) {
+  WriteLock lock(write_mu_);
+  Stmt(db_, "INSERT OR REPLACE INTO checkpoints(job, tile, passes, data) VALUES(?, ?, ?, ?)")
+      .bind(int64_t(job)).bind(int64_t(tile)).bind(int64_t(passes)).blob(data).step();
+  // The passes it holds keep their rows (for restart, retry and the lease log) without their bytes.
+  Stmt drop(db_, "UPDATE results SET data = x'' WHERE job = ? AND pass = ? AND tile = ?");
+  for (uint32_t pass = from; pass < passes; ++pass) {
+    drop.bind(int64_t(job)).bind(int64_t(pass)).bind(int64_t(tile)).step();
+    drop.reset();
+  }
+}
+
+void Store::for_each_checkpoint(uint64_t job, const std::function<void(CheckpointRow&&)>& fn) {
+  Stmt st(rd_, "SELECT tile, passes, data FROM checkpoints WHERE job = ? ORDER BY tile");
+  st.bind(int64_t(job));
+  while (st.step()) fn(CheckpointRow{uint32_t(st.i(0)), uint32_t(st.i(1)), st.s(2)});
+}
+
 void Store::for_each_result(uint64_t job, const std::function<void(ResultRow&&)>& fn, bool with_data) {
-  Stmt st(db_, with_data ? "SELECT tile, pass, worker, data FROM results WHERE job = ? ORDER BY pass, tile"
+  Stmt st(rd_, with_data ? "SELECT tile, pass, worker, data FROM results WHERE job = ? ORDER BY pass, tile"
                          : "SELECT tile, pass, worker, '' FROM results WHERE job = ? ORDER BY pass, tile");
   st.bind(int64_t(job));
   while (st.step()) fn(ResultRow{uint32_t(st.i(0)), uint32_t(st.i(1)), uint64_t(st.i(2)), st.s(3)});
 }
 
 uint64_t Store::reissued_after_ack(uint64_t job) {
-  Stmt st(db_,
+  Stmt st(rd_,
           "SELECT COUNT(*) FROM leases l JOIN results r ON r.job = l.job AND r.pass = l.pass AND r.tile = l.tile "
           "WHERE l.job = ? AND l.seq > r.ack_seq");
   st.bind(int64_t(job)).step();
@@ -195,13 +266,13 @@ uint64_t Store::reissued_after_ack(uint64_t job) {
 }
 
 uint64_t Store::leases_issued(uint64_t job) {
-  Stmt st(db_, "SELECT COUNT(*) FROM leases WHERE job = ?");
+  Stmt st(rd_, "SELECT COUNT(*) FROM leases WHERE job = ?");
   st.bind(int64_t(job)).step();
   return uint64_t(st.i(0));
 }
 
 std::vector<LeaseRow> Store::open_leases(uint64_t job) {
-  Stmt st(db_,
+  Stmt st(rd_,
           "SELECT l.seq, l.tile, l.pass, l.worker FROM leases l WHERE l.job = ? "
           "AND l.seq = (SELECT MAX(m.seq) FROM leases m WHERE m.job = l.job AND m.pass = l.pass AND m.tile = l.tile) "
           "AND NOT EXISTS (SELECT 1 FROM results r WHERE r.job = l.job AND r.pass = l.pass AND r.tile = l.tile)");
@@ -212,7 +283,7 @@ std::vector<LeaseRow> Store::open_leases(uint64_t job) {
 }
 
 std::pair<uint64_t, uint64_t> Store::lease_and_result_counts() {
-  Stmt st(db_, "SELECT (SELECT COUNT(*) FROM leases), (SELECT COUNT(*) FROM results)");
+  Stmt st(rd_, "SELECT (SELECT COUNT(*) FROM leases), (SELECT COUNT(*) FROM results)");
   st.step();
   return {uint64_t(st.i(0)), uint64_t(st.i(1))};
 }
@@ -220,12 +291,16 @@ std::pair<uint64_t, uint64_t> Store::lease_and_result_counts() {
 std::vector<std::pair<uint64_t, uint64_t>> Store::result_bytes(const std::vector<uint64_t>& ids) {
   std::vector<std::pair<uint64_t, uint64_t>> out;
   if (ids.empty()) {
-    Stmt st(db_, "SELECT job, SUM(LENGTH(data)) FROM results GROUP BY job");
+    Stmt st(rd_,
+            "SELECT job, SUM(bytes) FROM (SELECT job, LENGTH(data) AS bytes FROM results UNION ALL "
+            "SELECT job, LENGTH(data) FROM checkpoints) GROUP BY job");
     while (st.step()) out.emplace_back(uint64_t(st.i(0)), uint64_t(st.i(1)));
     return out;
   }
   for (uint64_t id : ids) {
-    Stmt st(db_, "SELECT COALESCE(SUM(LENGTH(data)), 0) FROM results WHERE job = ?");
+    Stmt st(rd_,
+            "SELECT (SELECT COALESCE(SUM(LENGTH(data)), 0) FROM results WHERE job = ?1) + "
+            "(SELECT COALESCE(SUM(LENGTH(data)), 0) FROM checkpoints WHERE job = ?1)");
     st.bind(int64_t(id)).step();
     out.emplace_back(id, uint64_t(st.i(0)));
   }
@@ -233,34 +308,35 @@ std::vector<std::pair<uint64_t, uint64_t>> Store::result_bytes(const std::vector
 }
 
 void Store::delete_job(uint64_t id, double now) {
-  exec("BEGIN IMMEDIATE");
-  try {
+  transaction([&] {
     Stmt(db_, "INSERT OR REPLACE INTO expired_jobs(id, name, expired) SELECT id, name, ? FROM jobs WHERE id = ?")
         .bind(now).bind(int64_t(id)).step();
     Stmt(db_, "DELETE FROM results WHERE job = ?").bind(int64_t(id)).step();
+    Stmt(db_, "DELETE FROM checkpoints WHERE job = ?").bind(int64_t(id)).step();
     Stmt(db_, "DELETE FROM leases WHERE job = ?").bind(int64_t(id)).step();
     Stmt(db_, "DELETE FROM jobs WHERE id = ?").bind(int64_t(id)).step();
-    exec("COMMIT");
-  } catch (...) {
-    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
-    throw;
-  }
+  });
 }
 
 std::optional<double> Store::expired_job(uint64_t id) {
-  Stmt st(db_, "SELECT expired FROM expired_jobs WHERE id = ?");
+  Stmt st(rd_, "SELECT expired FROM expired_jobs WHERE id = ?");
   if (!st.bind(int64_t(id)).step()) return std::nullopt;
   return st.d(0);
 }
 
 void Store::delete_scene(const std::string& hash) {
+  WriteLock lock(write_mu_);
   Stmt st(db_, "DELETE FROM scenes WHERE hash = ?");
   st.bind(hash).step();
 }
 
-void Store::incremental_vacuum() { exec("PRAGMA incremental_vacuum"); }
+void Store::incremental_vacuum() {
+  WriteLock lock(write_mu_);
+  exec("PRAGMA incremental_vacuum");
+}
 
 uint64_t Store::add_worker(const WorkerRow& w) {
+  WriteLock lock(write_mu_);
   Stmt st(db_,
           "INSERT INTO workers(name, threads, memory, version, isa, registered, last_seen, state) "
           "VALUES(?, ?, ?, ?, ?, ?, ?, 'idle')");
@@ -270,12 +346,13 @@ uint64_t Store::add_worker(const WorkerRow& w) {
 }
 
 std::optional<WorkerRow> Store::worker(uint64_t id) {
-  Stmt st(db_, "SELECT id, name, version, isa, threads, memory, registered FROM workers WHERE id = ?");
+  Stmt st(rd_, "SELECT id, name, version, isa, threads, memory, registered FROM workers WHERE id = ?");
   if (!st.bind(int64_t(id)).step()) return std::nullopt;
   return WorkerRow{uint64_t(st.i(0)), st.s(1), st.s(2), st.s(3), int(st.i(4)), uint64_t(st.i(5)), st.d(6)};
 }
 
 void Store::touch_worker(uint64_t id, double now, const std::string& state) {
+  WriteLock lock(write_mu_);
   Stmt st(db_, "UPDATE workers SET last_seen = ?, state = ? WHERE id = ?");
   st.bind(now).bind(state).bind(int64_t(id)).step();
 }

@@ -141,6 +141,31 @@ TEST(CoordinatorFailures, IdleWorkersGetOneCopyOfTheLastUnitAndTheFirstResultWin
   EXPECT_NE(c.metrics().find("tessera_passes_total{event=\"speculative\"} 1"), std::string::npos);
 }
 
+TEST(CoordinatorFailures, AResultCarriesTheNextLeaseAndItsRetryIsAnsweredAsTheFirstTime) {
+  TempDir dir;
+  TinyScene tiny;
+  Coordinator c(fast(dir, /*speculate=*/false));
+  const uint64_t a = add_worker(c, "a"), b = add_worker(c, "b");
+  const uint64_t id = c.submit_job(json{{"tile_size", 8}, {"spp", 1}, {"seed", 5}}, bundle()).value["id"];
+  json first = c.lease(a, 0).value;
+  ASSERT_TRUE(first.is_object());
+  const std::string bytes = render_unit(first, tiny.scene(), 5);
+  // The answer to a result asked with `next` holds the worker's next unit, leased to it.
+  json ack = c.upload_result(a, first["id"], bytes, /*next=*/true).value;
+  EXPECT_TRUE(ack["accepted"].get<bool>());
+  ASSERT_TRUE(ack["lease"].is_object());
+  EXPECT_NE(ack["lease"]["tile"], first["tile"]);
+  EXPECT_EQ(worker_state(c, a), "busy");
+  // Its answer lost, the worker sends it again: accepted as the first time, not a duplicate.
+  json retry = c.upload_result(a, first["id"], bytes).value;
+  EXPECT_TRUE(retry["accepted"].get<bool>());
+  EXPECT_FALSE(retry["duplicate"].get<bool>());
+  EXPECT_EQ(c.job_status(id).value["duplicate_results"], 0);
+  // Another worker's copy of the same unit is a duplicate.
+  EXPECT_TRUE(c.upload_result(b, 0, bytes).value["duplicate"].get<bool>());
+  EXPECT_EQ(c.job_status(id).value["duplicate_results"], 1);
+}
+
 TEST(CoordinatorFailures, ALaterResultThatDiffersIsCountedAsAMismatch) {
   TempDir dir;
   TinyScene tiny;

@@ -123,7 +123,9 @@ class Farm {
       if (client().get("/healthz", 2).ok()) return;
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
-    FAIL() << "the server does not answer /healthz";
+    std::ifstream log_file(log("server"));
+    const std::string text((std::istreambuf_iterator<char>(log_file)), std::istreambuf_iterator<char>());
+    FAIL() << "the server does not answer /healthz; its log ends with:\n" << text.substr(text.size() > 3000 ? text.size() - 3000 : 0);
   }
   void kill_server() { server_.kill_now(); }
   pid_t server_pid() const { return server_.pid(); }

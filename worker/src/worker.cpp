@@ -120,8 +120,14 @@ void Worker::heartbeat_loop() {
 
 void Worker::slot_loop(int slot) {
   int attempt = 0;
+  std::optional<Lease> next;  // handed out with the previous result
   while (!stop_) {
-    if (opt_.max_leases > 0 && leases_taken_ >= opt_.max_leases) break;
+    if (next) {
+      const Lease lease = std::move(*next);
+      next = process(lease);
+      continue;
+    }
+    if (!wants_more()) break;
     const uint64_t id = worker_id_;
     const auto t0 = Clock::now();
     client::ApiReply<std::optional<Lease>> r = api_.lease(id, opt_.poll_wait, opt_.poll_wait + 15);
@@ -154,11 +160,11 @@ void Worker::slot_loop(int slot) {
     attempt = 0;
     if (stop_) break;  // sign-off hands it back
     ++leases_taken_;
-    process(*r.value);
+    next = process(*r.value);
   }
 }
 
-void Worker::process(const Lease& lease) {
+std::optional<Lease> Worker::process(const Lease& lease) {
   {
     std::lock_guard<std::mutex> lock(leases_mutex_);
     active_[lease.id] = lease;
@@ -178,40 +184,44 @@ void Worker::process(const Lease& lease) {
     ++stats_.failures;
     spdlog::error("job {}: cannot load the scene: {}", lease.job_id, e.what());
     (void)api_.fail_lease(worker_id_.load(), lease.id, e.what());
-    return;
+    return std::nullopt;
   }
   TileResult result = render_lease(*scene->scene, lease);
   ++stats_.passes_rendered;
   const bool dropped = finish();
-  if (dropped) return;
-  if (upload(lease, encode_tile_result(result))) ++stats_.passes_uploaded;
+  if (dropped) return std::nullopt;
+  std::optional<client::ResultAck> ack = upload(lease, encode_tile_result(result));
+  if (!ack) return std::nullopt;
+  ++stats_.passes_uploaded;
+  if (ack->next) ++leases_taken_;
+  return std::move(ack->next);
 }
 
-bool Worker::upload(const Lease& lease, const std::string& bytes) {
+std::optional<client::ResultAck> Worker::upload(const Lease& lease, const std::string& bytes) {
   // Keeps trying while the coordinator is away (a restart), for up to ten minutes.
   const auto give_up = Clock::now() + std::chrono::minutes(10);
   int attempt = 0;
   while (Clock::now() < give_up) {
     const uint64_t id = worker_id_;
-    client::ApiReply<client::ResultAck> r = api_.upload_result(id, lease.id, bytes);
+    client::ApiReply<client::ResultAck> r = api_.upload_result(id, lease.id, bytes, 60, wants_more());
     if (r.ok()) {
       if (r.value.duplicate) ++stats_.duplicates;
-      return true;
+      return std::move(r.value);
     }
     if (r.http.status == 404 && r.http.json().value("error", "") == "unknown_worker") {
       std::lock_guard<std::mutex> lock(register_mutex_);
-      if (worker_id_ == id && !register_with_server()) return false;
+      if (worker_id_ == id && !register_with_server()) return std::nullopt;
       continue;
     }
     if (r.http.status >= 400 && r.http.status < 500) {
       // Refused for good (job cancelled, unit no longer exists): nothing to retry.
       spdlog::info("job {} tile {} pass {}: result not taken: {}", lease.job_id, lease.tile, lease.pass, r.describe());
-      return false;
+      return std::nullopt;
     }
     if (attempt == 0) spdlog::warn("upload failed: {}; retrying", r.describe());
     backoff(attempt, /*interruptible=*/false);  // a finished pass is delivered even when stopping
   }
-  return false;
+  return std::nullopt;
 }
 
 }  // namespace tessera::farm

@@ -32,7 +32,19 @@ struct Registration {
 
 struct ResultAck {
   bool accepted = false, duplicate = false;
+  std::optional<Lease> next;  // asked for with the result (`want_next`): the worker's next unit
 };
+
+/// One of the worker's hot requests as plain HTTP pieces, for a caller with a transport of its own
+/// (the load benchmark's event loop); FarmApi sends exactly these.
+struct RequestSpec {
+  std::string method, path, content_type, body;
+};
+RequestSpec lease_request(uint64_t worker, double wait);
+RequestSpec result_request(uint64_t worker, uint64_t lease, std::string tile_result, bool want_next);
+/// Their answers, decoded as FarmApi decodes them (a 204 to a lease request: no lease).
+ApiReply<std::optional<Lease>> decode_lease_reply(HttpReply http);
+ApiReply<ResultAck> decode_result_reply(HttpReply http);
 
 class FarmApi {
  public:
@@ -65,8 +77,10 @@ class FarmApi {
   /// The ids among `held` the coordinator no longer wants (cancelled, or delivered by another).
   ApiReply<std::vector<uint64_t>> heartbeat(uint64_t worker, const std::vector<HeldLease>& held,
                                             double timeout = 10) const;
+  /// With `want_next`, the answer also carries the worker's next lease when there is work for it
+  /// now (one request and one commit instead of two; no long poll).
   ApiReply<ResultAck> upload_result(uint64_t worker, uint64_t lease, const std::string& tile_result,
-                                    double timeout = 60) const;
+                                    double timeout = 60, bool want_next = false) const;
   HttpReply fail_lease(uint64_t worker, uint64_t lease, const std::string& error, double timeout = 10) const;
   HttpReply sign_off(uint64_t worker, double timeout = 10) const;
 

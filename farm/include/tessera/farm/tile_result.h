@@ -26,8 +26,9 @@ struct TileResult {
   FilmTile film;       // rect, sums and counters
 };
 
-/// Encodes (and compresses) a result; `level` is zstd's compression level.
-std::string encode_tile_result(const TileResult& result, int level = 3);
+/// Encodes (and compresses) a result; `level` is zstd's compression level. Pixel sums are noise in
+/// their low bits: level 1 makes them as small as level 3 does (within 0.2%) in a third of the time.
+std::string encode_tile_result(const TileResult& result, int level = 1);
 
 /// Decodes and verifies bytes from the network. False with `error` set on anything malformed:
 /// bad compression, wrong magic or version, a size that does not match the rect, a checksum

@@ -28,6 +28,10 @@ struct CoordinatorOptions {
   // for their workers to re-adopt them.
   double heartbeat_interval = 2;
   double max_poll_wait = 30;      // upper bound of a lease long poll
+  // Group commit (group_commit.h): under load, a state-database commit starts at most this often
+  // (seconds), taking every lease, result and phase change decided meanwhile: fewer fsyncs per
+  // unit for at most this much more latency. 0: commit as soon as the previous commit ends.
+  double commit_interval = 0.002;
   int max_waiting_polls = 16;     // concurrent long polls; more get 204 at once (never starve clients)
   // Idle workers get a copy of a job's oldest outstanding unit once it has no unleased one
   // (scheduler.h); the first result wins and a later one must match it bit for bit.
@@ -98,7 +102,9 @@ class Coordinator {
   Result<nlohmann::json> heartbeat(uint64_t worker, const std::vector<HeldLease>& held);
   /// A tile result (tile_result.h bytes). Accepted once per unit: a duplicate is acknowledged and
   /// dropped. Valid without a live lease too (a worker finishing across a coordinator restart).
-  Result<nlohmann::json> upload_result(uint64_t worker, uint64_t lease, std::string_view bytes);
+  /// Answered once durable. With `next`, the answer also carries the worker's next lease ("lease",
+  /// null when there is no work it may take now), logged in the same commit as the result.
+  Result<nlohmann::json> upload_result(uint64_t worker, uint64_t lease, std::string_view bytes, bool next = false);
   Status fail_lease(uint64_t worker, uint64_t lease, const nlohmann::json& body);
   Status sign_off(uint64_t worker, const nlohmann::json& body);
   /// Draining: the worker finishes what it renders and gets no more work (its lease polls are

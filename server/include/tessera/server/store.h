@@ -1,12 +1,18 @@
 // The coordinator's durable state in SQLite (WAL, synchronous=FULL): scenes, jobs, acknowledged
-// tile-pass results (as the compressed bytes the worker sent), the lease log and workers.
+// tile-pass results (as the compressed bytes the worker sent, until a per-tile checkpoint of the
+// film's sums holds them), the checkpoints, the lease log and workers.
 // A result is committed (fsync'd) before the coordinator acknowledges it, so after kill -9 every
 // acknowledged pass is still here. Methods throw StoreError; services map it to 500/507.
+//
+// Writes go through one connection, one at a time (the coordinator's group commit batches most of
+// them in transaction()); reads use a second connection and see committed data only. Safe to call
+// from any thread.
 #pragma once
 
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -50,6 +56,11 @@ struct LeaseRow {
   uint64_t worker = 0;
 };
 
+struct CheckpointRow {
+  uint32_t tile = 0, passes = 0;
+  std::string data;
+};
+
 struct ResultRow {
   uint32_t tile = 0, pass = 0;
   uint64_t worker = 0;
@@ -64,6 +75,10 @@ class Store {
   Store(const Store&) = delete;
   Store& operator=(const Store&) = delete;
 
+  /// Runs `writes` (calls of the write methods below) in one transaction: all committed with one
+  /// fsync, or none (rolled back, and the error rethrown).
+  void transaction(const std::function<void()>& writes);
+
   void add_scene(const std::string& hash, uint64_t bytes, double now);
   bool has_scene(const std::string& hash);
 
@@ -73,12 +88,19 @@ class Store {
   void set_job_priority(uint64_t id, int priority);
   std::vector<JobRow> jobs();
 
-  /// Logs a lease; returns its sequence number.
-  uint64_t log_lease(uint64_t job, uint32_t tile, uint32_t pass, uint64_t worker, double now);
+  /// Logs lease `seq` (ids are chosen by the caller, above last_lease_seq(), and never reused).
+  void log_lease(uint64_t seq, uint64_t job, uint32_t tile, uint32_t pass, uint64_t worker, double now);
+  /// The largest lease id ever logged (also once its rows were deleted).
+  uint64_t last_lease_seq();
   /// Commits an acknowledged result. False if (job, tile, pass) already had one (a duplicate).
   bool add_result(uint64_t job, uint32_t tile, uint32_t pass, uint64_t worker, const std::string& data,
                   double now);
-  /// Calls `fn` for every result of `job`, ordered by pass then tile (`with_data`: the bytes too).
+  /// Stores a tile's checkpoint (its sums over passes 0..passes-1, tile_result.h bytes) and drops
+  /// the bytes of the results of passes from..passes-1, which it now holds; their rows stay.
+  void save_checkpoint(uint64_t job, uint32_t tile, uint32_t from, uint32_t passes, const std::string& data);
+  void for_each_checkpoint(uint64_t job, const std::function<void(CheckpointRow&&)>& fn);
+  /// Calls `fn` for every result of `job`, ordered by pass then tile (`with_data`: the bytes too;
+  /// empty for a pass a checkpoint holds).
   void for_each_result(uint64_t job, const std::function<void(ResultRow&&)>& fn, bool with_data = true);
   /// Leases issued for a pass after that pass had been acknowledged (should be 0: the measure the
   /// restart test reads).
@@ -91,7 +113,8 @@ class Store {
   std::pair<uint64_t, uint64_t> lease_and_result_counts();
 
   // Retention (retention.cpp): sizes, deletion of a finished job, tombstones for its id.
-  /// Bytes of stored result data per job (only the jobs in `ids`, or every job when empty).
+  /// Bytes of stored result and checkpoint data per job (only the jobs in `ids`, or every job when
+  /// empty).
   std::vector<std::pair<uint64_t, uint64_t>> result_bytes(const std::vector<uint64_t>& ids = {});
   /// Deletes a job's results, lease log and row in one transaction, leaving a tombstone (its id,
   /// name and when it expired) so its status can say why it is gone.
@@ -108,8 +131,11 @@ class Store {
   void touch_worker(uint64_t id, double now, const std::string& state);
 
  private:
+  using WriteLock = std::lock_guard<std::recursive_mutex>;
   void exec(const char* sql);
-  sqlite3* db_ = nullptr;
+  sqlite3* db_ = nullptr;  // writes
+  sqlite3* rd_ = nullptr;  // reads
+  std::recursive_mutex write_mu_;  // a transaction's writes are never interleaved with another's
 };
 
 }  // namespace tessera::server

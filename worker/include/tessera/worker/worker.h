@@ -10,6 +10,7 @@
 #include <atomic>
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <mutex>
 #include <string>
 
@@ -45,8 +46,12 @@ class Worker {
   bool register_with_server();
   void slot_loop(int slot);
   void heartbeat_loop();
-  void process(const Lease& lease);
-  bool upload(const Lease& lease, const std::string& bytes);
+  /// Renders and delivers one lease; the next lease when the coordinator sent one with the answer.
+  std::optional<Lease> process(const Lease& lease);
+  /// Delivers a result (asking for the next lease with it while this slot wants more work); its
+  /// answer, or nothing when it could not be delivered.
+  std::optional<client::ResultAck> upload(const Lease& lease, const std::string& bytes);
+  bool wants_more() const { return !stop_ && (opt_.max_leases <= 0 || leases_taken_ < opt_.max_leases); }
   void backoff(int& attempt, bool interruptible = true);
 
   WorkerOptions opt_;

@@ -1,9 +1,6 @@
-// The coordinator process, CPU accounting and the simulated workers of tessera-farm-load.
+// The coordinator process and CPU accounting of tessera-farm-load.
 #include "farm_load.h"
 
-#include "tessera/farm/build_fingerprint.h"
-#include "tessera/farm/protocol.h"
-#include "tessera/farm/tile_result.h"
 #include "tessera/client/farm_api.h"
 
 #include <fcntl.h>
@@ -28,21 +25,9 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 using nlohmann::json;
 
-namespace {
-
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
-
-void sleep_unless_stopped(const SimShared& shared, double seconds) {
-  for (auto end = Clock::now() + std::chrono::duration<double>(seconds); Clock::now() < end && !shared.stop;)
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-}
-
-}  // namespace
 
 ServerProcess::ServerProcess(const std::string& binary, const std::string& dir, int http_threads,
-                             double max_poll_wait) {
+                             double max_poll_wait, const std::vector<std::string>& extra_args) {
   const std::string port_file = (fs::path(dir) / "port").string();
   log_ = (fs::path(dir) / "server.log").string();
   std::vector<std::string> args = {binary, "--listen", "127.0.0.1:0", "--port-file", port_file,
@@ -51,6 +36,7 @@ ServerProcess::ServerProcess(const std::string& binary, const std::string& dir, 
                                    "--max-poll-wait", std::to_string(max_poll_wait),
                                    // Each unit leased once: the run checks every lease ends accepted.
                                    "--no-speculation"};
+  args.insert(args.end(), extra_args.begin(), extra_args.end());
   std::vector<std::string> env;
   for (char** e = environ; *e; ++e) {
     std::string entry(*e);
@@ -152,111 +138,6 @@ double self_cpu_seconds() {
   getrusage(RUSAGE_SELF, &u);
   auto seconds = [](const timeval& t) { return double(t.tv_sec) + 1e-6 * double(t.tv_usec); };
   return seconds(u.ru_utime) + seconds(u.ru_stime);
-}
-
-namespace {
-
-// Pixel sums with the size and entropy of a real pass (so the bytes on the wire and in the store
-// are realistic), for exactly the leased unit.
-void fill_synthetic(const Lease& lease, uint64_t& rng, TileResult& result) {
-  result.job_id = lease.job_id;
-  result.tile = lease.tile;
-  result.pass = lease.pass;
-  result.sample_begin = lease.sample_begin;
-  result.sample_end = lease.sample_end;
-  result.seconds = 0.001;
-  result.film.reset(lease.rect);
-  const uint32_t n = lease.sample_end - lease.sample_begin;
-  for (PixelSums& p : result.film.mutable_pixels()) {
-    for (int c = 0; c < 3; ++c) {
-      rng ^= rng << 13, rng ^= rng >> 7, rng ^= rng << 17;  // xorshift64
-      const double v = double(rng >> 11) * 0x1p-53;
-      p.sum[c] = v * n;
-      p.sum_sq[c] = v * v * n;
-    }
-    p.count = n;
-  }
-  result.film.counters.samples = uint64_t(lease.rect.area()) * n;
-  result.film.counters.camera_rays = result.film.counters.samples;
-}
-
-void note_error(SimStats& st, const std::string& what) {
-  if (st.errors++ == 0) st.first_error = what;
-}
-
-// Uploads one result, retrying transport failures and 5xx a few times (the real worker retries
-// for minutes; here a lost upload is a finding).
-void upload(const client::FarmApi& api, uint64_t worker, const Lease& lease, const std::string& bytes,
-            SimShared& shared, SimStats& st) {
-  for (int attempt = 0; attempt < 3; ++attempt) {
-    const auto t0 = Clock::now();
-    client::ApiReply<client::ResultAck> r = api.upload_result(worker, lease.id, bytes);
-    if (r.ok()) {
-      st.upload_ms.push_back(ms_since(t0));
-      if (r.value.duplicate) {
-        ++st.duplicates;
-      } else if (r.value.accepted) {
-        ++st.accepted;
-        ++shared.accepted;
-      } else {
-        note_error(st, "upload answered neither accepted nor duplicate: " + r.http.body);
-      }
-      return;
-    }
-    if (r.http.status != 0 && r.http.status < 500) {
-      note_error(st, "upload of job " + std::to_string(lease.job_id) + " unit " + std::to_string(lease.tile) + "/" +
-                         std::to_string(lease.pass) + " refused: " + r.describe());
-      return;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
-  note_error(st, "upload failed three times");
-}
-
-}  // namespace
-
-void run_simulated_worker(int index, SimShared& shared, SimStats& st) {
-  try {
-    client::FarmApi api(client::FarmClient(shared.url));
-    const BuildFingerprint& fp = build_fingerprint();  // the check the real worker passes
-    WorkerHello hello{"load-" + std::to_string(index), 1, uint64_t(1) << 30, fp.version, fp.isa, fp.probe};
-    client::ApiReply<client::Registration> reg = api.register_worker(hello);
-    const uint64_t id = reg.ok() ? reg.value.id : 0;
-    st.registered = id != 0;
-    ++shared.registered;
-    if (!st.registered) return note_error(st, "registration: " + reg.describe());
-    while (!shared.start && !shared.stop) std::this_thread::sleep_for(std::chrono::milliseconds(1));
-
-    uint64_t rng = 0x9E3779B97F4A7C15ull * uint64_t(index + 1);
-    TileResult result;
-    while (!shared.stop) {
-      const auto t0 = Clock::now();
-      client::ApiReply<std::optional<Lease>> r = api.lease(id, shared.poll_wait, shared.poll_wait + 15);
-      const double ms = ms_since(t0);
-      if (r.ok() && !r.value) {
-        ++st.empty_polls;
-        // Answered at once: the coordinator's long-poll slots are full; back off as tessera-worker does.
-        if (ms < 500) sleep_unless_stopped(shared, 0.25);
-        continue;
-      }
-      if (!r.ok()) {
-        note_error(st, "lease request: " + r.describe());
-        sleep_unless_stopped(shared, 0.1);
-        continue;
-      }
-      const Lease& lease = *r.value;
-      st.lease_ms.push_back(ms);
-      ++st.leased;
-      // A lease taken is completed even when stopping: every unit leased must end accepted.
-      fill_synthetic(lease, rng, result);
-      upload(api, id, lease, encode_tile_result(result), shared, st);
-    }
-    client::HttpReply off = api.sign_off(id);
-    st.signed_off = off.ok();
-    if (!off.ok()) note_error(st, "sign-off: " + off.describe());
-  } catch (const std::exception& e) {
-    note_error(st, std::string("exception: ") + e.what());
-  }
 }
 
 }  // namespace tessera::bench
