@@ -100,6 +100,10 @@ struct Coordinator::Impl {
   }
   /// Under `mu`: the unit an uploaded result is for, once worker, job and unit check out.
   Result<size_t> check_result(uint64_t worker, const TileResult& result);
+  /// Under `mu`: appends a checked result for `unit` (now committing) to the group commit; its
+  /// ticket. Once durable, result_committed adds it to the job.
+  uint64_t commit_result(JobState& job, size_t unit, uint64_t worker, const std::shared_ptr<TileResult>& result,
+                         std::string_view bytes);
   /// Under `mu`, once durable (a group-commit callback): the result enters its job, which may then
   /// be done; `durable` false: the unit is open again.
   void result_committed(bool durable, uint64_t job, size_t unit, uint64_t worker, TileResult& result, size_t bytes);
@@ -170,6 +174,8 @@ struct Coordinator::Impl {
 };
 
 double wall_seconds();
+/// A tile's checkpoint as stored: tile_result.h bytes (pass: its last pass; samples 0..sample_end).
+std::string encode_checkpoint(uint64_t job, const JobState::Checkpoint& cp);
 Status internal_error(const std::exception& e);
 inline Status unknown_job(uint64_t id) {
   return make_error(Code::NotFound, "unknown_job", "no job " + std::to_string(id));

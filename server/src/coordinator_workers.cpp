@@ -275,6 +275,30 @@ void Coordinator::Impl::result_committed(bool durable, uint64_t job_id, size_t u
   if (!is_terminal(job.phase) && job.complete()) (void)change_phase(job, JobPhase::Done);
 }
 
+uint64_t Coordinator::Impl::commit_result(JobState& job, size_t unit, uint64_t worker,
+                                          const std::shared_ptr<TileResult>& result, std::string_view bytes) {
+  // The tile's next pass with all before it checkpointed: stored as the tile's new checkpoint (its
+  // own bytes never stored). Otherwise stored as it came, and folded in later.
+  std::shared_ptr<JobState::Checkpoint> cp;
+  if (auto with = job.checkpoint_with(unit, result->film)) cp = std::make_shared<JobState::Checkpoint>(std::move(*with));
+  job.start_commit(unit);
+  // Another copy is still being rendered (speculative, or re-issued from a worker thought dead):
+  // its result will be checked against this one.
+  if (job.active_leases(unit) > 0) job.remember_digest(unit, tile_digest(result->film));
+  return commits.append(
+      [id = job.id(), tile = result->tile, pass = result->pass, worker, cp, data = cp ? "" : std::string(bytes),
+       now = wall_seconds()](Store& st) {
+        (void)st.add_result(id, tile, pass, worker, data, now);
+        if (cp) st.save_checkpoint(id, tile, cp->from, cp->passes, encode_checkpoint(id, *cp));
+      },
+      GroupCommit::Retry::No,
+      [this, id = job.id(), unit, worker, result, cp, n = bytes.size()](bool durable) {
+        auto it = jobs.find(id);
+        if (durable && cp && it != jobs.end()) it->second->checkpoint_stored(cp->tile, cp->passes);
+        result_committed(durable, id, unit, worker, *result, n);
+      });
+}
+
 std::optional<Coordinator::Impl::IssuedLease> Coordinator::Impl::next_lease(uint64_t worker) {
   WorkerInfo* w = find_worker(worker);
   if (stopping || !w || w->state == WorkerState::Draining) return std::nullopt;
@@ -314,17 +338,7 @@ Result<json> Coordinator::upload_result(uint64_t worker, uint64_t /*lease*/, std
       if (!issued) return json{{"accepted", false}, {"duplicate", true}, {"lease", nullptr}};
       ticket = issued->ticket;
     } else {
-      job.start_commit(unit);
-      // Another copy is still being rendered (speculative, or re-issued from a worker thought dead):
-      // its result will be checked against this one.
-      if (job.active_leases(unit) > 0) job.remember_digest(unit, tile_digest(result->film));
-      ticket = s.commits.append(
-          [job = job.id(), tile = result->tile, pass = result->pass, worker, data = std::string(bytes),
-           now = wall_seconds()](Store& st) { (void)st.add_result(job, tile, pass, worker, data, now); },
-          GroupCommit::Retry::No,
-          [&s, job = job.id(), unit, worker, result, n = bytes.size()](bool durable) {
-            s.result_committed(durable, job, unit, worker, *result, n);
-          });
+      ticket = s.commit_result(job, unit, worker, result, bytes);
       if (next) issued = s.next_lease(worker);  // (logged after the result: one commit for both)
     }
   }

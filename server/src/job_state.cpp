@@ -41,6 +41,7 @@ JobState::JobState(uint64_t id, JobPlan plan, std::string name, int priority, do
   accepted_from_.assign(num_units(), 0);
   next_pass_.assign(tiles_.size(), 0);
   folded_.assign(tiles_.size(), 0);
+  tile_committing_.assign(tiles_.size(), 0);
   tile_counters_.assign(tiles_.size(), RenderCounters{});
   total_samples_ = uint64_t(plan_.window.area()) * uint64_t(plan_.settings.spp);
   pass_done_.assign(passes_.size(), 0);
@@ -104,6 +105,7 @@ bool JobState::add_result(size_t unit, FilmTile&& tile, uint64_t worker) {
     ++duplicates;
     return false;
   }
+  if (done_[unit] == kCommitting) --tile_committing_[tile_of(unit)];
   mark_done(unit, worker);
   counters_ += tile.counters;
 
@@ -122,20 +124,50 @@ bool JobState::add_result(size_t unit, FilmTile&& tile, uint64_t worker) {
   return true;
 }
 
-std::optional<JobState::Checkpoint> JobState::take_checkpoint(uint32_t t, uint32_t min_new) {
-  if (!film_ || next_pass_[t] < folded_[t] + std::max<uint32_t>(1, min_new)) return std::nullopt;
+// The tile's region of the film (zero before the film exists) with its passes' counters.
+JobState::Checkpoint JobState::film_checkpoint(uint32_t t) const {
   Checkpoint cp;
   cp.tile = t;
   cp.from = folded_[t];
   cp.passes = next_pass_[t];
-  cp.sample_end = sample_end(unit(t, cp.passes - 1));
   const TileRect& r = tiles_[t];
   cp.sums.reset(r);
-  std::vector<PixelSums>& out = cp.sums.mutable_pixels();
-  for (int y = r.y0; y < r.y1; ++y)
-    for (int x = r.x0; x < r.x1; ++x) out[size_t(y - r.y0) * size_t(r.width()) + size_t(x - r.x0)] = film_->pixel({x, y});
+  if (film_) {
+    std::vector<PixelSums>& out = cp.sums.mutable_pixels();
+    for (int y = r.y0; y < r.y1; ++y)
+      for (int x = r.x0; x < r.x1; ++x)
+        out[size_t(y - r.y0) * size_t(r.width()) + size_t(x - r.x0)] = film_->pixel({x, y});
+  }
   cp.sums.counters = tile_counters_[t];
+  return cp;
+}
+
+std::optional<JobState::Checkpoint> JobState::take_checkpoint(uint32_t t, uint32_t min_new) {
+  if (!film_ || next_pass_[t] < folded_[t] + std::max<uint32_t>(1, min_new)) return std::nullopt;
+  Checkpoint cp = film_checkpoint(t);
+  cp.sample_end = sample_end(unit(t, cp.passes - 1));
   folded_[t] = cp.passes;
+  return cp;
+}
+
+std::optional<JobState::Checkpoint> JobState::checkpoint_with(size_t u, const FilmTile& result) const {
+  const uint32_t t = tile_of(u);
+  if (film_released_ || pass_of(u) != next_pass_[t] || folded_[t] != next_pass_[t] || tile_committing_[t] > 0)
+    return std::nullopt;
+  Checkpoint cp = film_checkpoint(t);
+  cp.passes = next_pass_[t] + 1;
+  cp.sample_end = sample_end(u);
+  // The same additions add_tile makes, in the same order: the film's region once it is in.
+  std::vector<PixelSums>& out = cp.sums.mutable_pixels();
+  const std::vector<PixelSums>& in = result.pixels();
+  for (size_t i = 0; i < out.size(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      out[i].sum[c] += in[i].sum[c];
+      out[i].sum_sq[c] += in[i].sum_sq[c];
+    }
+    out[i].count += in[i].count;
+  }
+  cp.sums.counters += result.counters;
   return cp;
 }
 

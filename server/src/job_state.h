@@ -78,9 +78,15 @@ class JobState {
   /// A result for the unit is being committed: it is not leased again meanwhile, and a second
   /// result is a duplicate. Ended by add_result, or by commit_failed (the unit is open again).
   bool is_committing(size_t unit) const { return done_[unit] == kCommitting; }
-  void start_commit(size_t unit) { done_[unit] = kCommitting; }
+  void start_commit(size_t unit) {
+    done_[unit] = kCommitting;
+    ++tile_committing_[tile_of(unit)];
+  }
   void commit_failed(size_t unit) {
-    if (done_[unit] == kCommitting) done_[unit] = kOpen;
+    if (done_[unit] == kCommitting) {
+      done_[unit] = kOpen;
+      --tile_committing_[tile_of(unit)];
+    }
     digests_.erase(unit);
   }
   /// The digest of a unit's accepted sums, kept when another copy of it was in flight (also once
@@ -107,6 +113,14 @@ class JobState {
   };
   /// The tile's checkpoint once at least `min_new` passes entered the film since the last one.
   std::optional<Checkpoint> take_checkpoint(uint32_t tile, uint32_t min_new);
+  /// The checkpoint the tile will have once `result` (for `unit`, about to be committed) is in:
+  /// when it is the tile's next pass, every pass before it is in a checkpoint and no other result
+  /// of the tile is being committed. Stored in the result's place, its bytes never need storing.
+  std::optional<Checkpoint> checkpoint_with(size_t unit, const FilmTile& result) const;
+  /// That checkpoint was stored (with the result, which add_result then adds to the film).
+  void checkpoint_stored(uint32_t tile, uint32_t passes) { folded_[tile] = std::max(folded_[tile], passes); }
+  /// Passes of the tile in the film (a stored result of an earlier pass is in a checkpoint).
+  uint32_t passes_in_film(uint32_t tile) const { return next_pass_[tile]; }
   /// The checkpoint was not stored: its passes are checkpointed again next time.
   void checkpoint_failed(uint32_t tile, uint32_t from) { folded_[tile] = std::min(folded_[tile], from); }
   /// Rebuilding: the tile's sums over its first `passes` passes (their units are marked done from
@@ -160,10 +174,12 @@ class JobState {
   std::vector<uint64_t> accepted_from_;  // per done unit: the worker its result came from
   std::vector<uint32_t> next_pass_;              // per tile: passes already in the film
   std::vector<uint32_t> folded_;                 // per tile: passes in its checkpoint
+  std::vector<uint16_t> tile_committing_;        // per tile: results being committed
   std::vector<RenderCounters> tile_counters_;    // per tile: counters of the passes in the film
   std::map<size_t, FilmTile> waiting_;           // results that arrived before an earlier pass
   std::map<size_t, Sha256Digest> digests_;       // see remember_digest
   void advance_passes();
+  Checkpoint film_checkpoint(uint32_t tile) const;
 
   size_t done_units_ = 0, first_open_ = 0;
   std::vector<uint32_t> pass_done_;  // per pass: tiles that have it

@@ -14,8 +14,6 @@ namespace {
 
 using nlohmann::json;
 
-std::string cornell() { return shared_path("scenes/cornell-box/scene.xml"); }
-
 // Asserts status and that the body is {"error": ..., "detail": ...}; returns the detail.
 std::string expect_error(const client::HttpReply& r, int status) {
   EXPECT_EQ(r.status, status) << r.body;

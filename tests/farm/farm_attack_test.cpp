@@ -22,8 +22,6 @@ using nlohmann::json;
 constexpr const char* kClient = "client-attack-5c1e";
 constexpr const char* kWorker = "worker-attack-0d42";
 
-std::string cornell() { return shared_path("scenes/cornell-box/scene.xml"); }
-
 // Counts attacks and refusals, and says which attack got through.
 struct Tally {
   int attacks = 0, refused = 0;

@@ -11,8 +11,6 @@ using nlohmann::json;
 constexpr const char* kClient = "client-secret-7f3a";
 constexpr const char* kWorker = "worker-secret-91bd";
 
-std::string cornell() { return shared_path("scenes/cornell-box/scene.xml"); }
-
 struct Call {
   std::string method, path;
   bool worker;  // needs the worker token (else the client token)

@@ -20,8 +20,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string cornell() { return shared_path("scenes/cornell-box/scene.xml"); }
-
 // Unmounts in every exit path (after the server using it is killed).
 class Tmpfs {
  public:

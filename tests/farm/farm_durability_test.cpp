@@ -19,8 +19,6 @@
 namespace tessera::test {
 namespace {
 
-std::string cornell() { return shared_path("scenes/cornell-box/scene.xml"); }
-
 // Many small units: 128x96 in 8-pixel tiles (192 tiles) x 6 passes (37 spp) = 1152 units.
 JobSettings many_units() {
   JobSettings s;

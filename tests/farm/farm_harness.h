@@ -223,6 +223,9 @@ class Farm {
   std::vector<Child> workers_;
 };
 
+/// The Cornell box of ../shared/scenes, the farm tests' scene.
+inline std::string cornell() { return shared_path("scenes/cornell-box/scene.xml"); }
+
 /// `tessera render`'s image for the same scene and settings, rendered in this process.
 inline Image local_render(const std::string& scene, const JobSettings& settings) {
   auto abs = std::filesystem::absolute(scene);

@@ -8,8 +8,6 @@
 namespace tessera::test {
 namespace {
 
-std::string cornell() { return shared_path("scenes/cornell-box/scene.xml"); }
-
 // 100 wide with tiles of 24 (not a multiple); 37 spp (not a power of two): passes 1,2,4,8,16,6.
 JobSettings small_job() {
   JobSettings s;

@@ -11,7 +11,6 @@ namespace {
 
 using nlohmann::json;
 
-std::string cornell() { return shared_path("scenes/cornell-box/scene.xml"); }
 std::string animation() { return std::string(TESSERA_SOURCE_DIR) + "/scenes/animation/scene.xml"; }
 
 // Posts settings + the scene's bundle (as tessera submit does), with extra fields merged in.

@@ -9,8 +9,6 @@
 namespace tessera::test {
 namespace {
 
-std::string cornell() { return shared_path("scenes/cornell-box/scene.xml"); }
-
 // A self-signed certificate for 127.0.0.1 (made with the openssl command, as an operator would).
 bool make_certificate(const TempDir& dir, const std::string& name) {
   const std::string base = (dir.path / name).string();
