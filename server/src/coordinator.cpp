@@ -65,6 +65,8 @@ Coordinator::Coordinator(CoordinatorOptions options) : impl_(std::make_unique<Im
   // Resume: every job's acknowledged passes go back into its film; leases in flight died with the
   // previous process, so their units are simply available again.
   size_t resumed = 0, passes = 0;
+  // (Under the lock: the group commit's callbacks and image writes take it too.)
+  std::lock_guard<std::mutex> lock(s.mu);
   s.last_lease_id = s.store.last_lease_seq();
   for (JobRow& row : s.store.jobs()) {
     JobPhase phase;
@@ -80,22 +82,16 @@ Coordinator::Coordinator(CoordinatorOptions options) : impl_(std::make_unique<Im
       s.jobs.emplace(row.id, std::move(job));
       continue;
     }
-    auto job = s.rebuild_job(row);
-    passes += job->done_units();
-    try {
-      if (!is_terminal(job->phase) && job->complete()) {  // its last result landed before a crash
-        s.commits.wait(s.change_phase(*job, JobPhase::Done));
-      } else if (is_terminal(job->phase)) {
-        s.finish_job(*job, /*notify=*/false);  // it ended before its image was written
-      } else {
-        ++resumed;
-        s.hold_open_leases(*job);
-      }
-    } catch (const StoreError& e) {  // a full disk: the image is retried by the retention pass
-      if (!e.disk_full) throw;
-      spdlog::warn("job {}: {}", row.id, e.what());
+    JobState& job = *s.jobs.emplace(row.id, s.rebuild_job(row)).first->second;
+    passes += job.done_units();
+    if (!is_terminal(job.phase) && job.complete()) {  // its last result landed before a crash
+      (void)s.change_phase(job, JobPhase::Done);
+    } else if (is_terminal(job.phase)) {
+      s.finish_job(job, /*notify=*/false);  // it ended before its image was written
+    } else {
+      ++resumed;
+      s.hold_open_leases(job);
     }
-    s.jobs.emplace(row.id, std::move(job));
   }
   // /metrics counts from what the data dir holds, so "done" never exceeds "leased" after a restart.
   std::tie(s.counters.leased, s.counters.done) = s.store.lease_and_result_counts();
@@ -216,17 +212,41 @@ std::string Coordinator::Impl::image_path(uint64_t job) const {
 }
 
 void Coordinator::Impl::finish_job(JobState& job, bool notify) {
-  if (is_terminal(job.phase) && job.has_film()) {
-    // Its sums stay (a retried job goes on from them) as one checkpoint per tile, not as results.
-    for (uint32_t t = 0; t < job.num_tiles(); ++t) checkpoint_tile(job, t, 1);
-    const std::string path = image_path(job.id());
-    write_image_durably(path, job.image(),
-                {{"tessera_version", TESSERA_VERSION}, {"tessera_job", std::to_string(job.id())},
-                 {"tessera_spp", std::to_string(image_spp(job))},
-                 {"tessera_seed", std::to_string(job.plan().settings.seed)}}, opt.data_dir);
-    job.release_film();
+  if (!is_terminal(job.phase) || job.image_pending) return;
+  if (!job.has_film()) {  // its image is on disk already
+    if (notify) send_webhook(job);
+    return;
   }
-  if (notify && is_terminal(job.phase) && !job.plan().settings.webhook.empty())
+  // Its sums stay (a retried job goes on from them) as one checkpoint per tile, not as results.
+  for (uint32_t t = 0; t < job.num_tiles(); ++t) checkpoint_tile(job, t, 1);
+  // The image is written off the lock; until then it is served from the film.
+  job.image_pending = true;
+  ImageAttributes attributes = {{"tessera_version", TESSERA_VERSION}, {"tessera_job", std::to_string(job.id())},
+                                {"tessera_spp", std::to_string(image_spp(job))},
+                                {"tessera_seed", std::to_string(job.plan().settings.seed)}};
+  background.push([this, id = job.id(), image = job.image(), attributes = std::move(attributes), notify] {
+    std::string error;
+    try {
+      write_image_durably(image_path(id), image, attributes, opt.data_dir);
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    std::lock_guard<std::mutex> lock(mu);
+    auto it = jobs.find(id);
+    if (it == jobs.end()) return;
+    JobState& j = *it->second;
+    j.image_pending = false;
+    if (!error.empty())  // (a full disk: the film stays, and the retention pass tries again)
+      return spdlog::warn("job {}: image not written yet: {}", id, error);
+    if (!is_terminal(j.phase)) return;  // retried meanwhile: its film goes on
+    j.release_film();
+    log_event(spdlog::level::debug, "job.image_saved", {{"job", id}});
+    if (notify) send_webhook(j);
+  });
+}
+
+void Coordinator::Impl::send_webhook(const JobState& job) {
+  if (!job.plan().settings.webhook.empty())
     webhooks.send(job.id(), job.plan().settings.webhook, status_json(job).dump());
 }
 

@@ -3,6 +3,7 @@
 // their records to be durable after releasing it.
 #pragma once
 
+#include "background_queue.h"
 #include "group_commit.h"
 #include "job_state.h"
 #include "metrics.h"
@@ -138,9 +139,12 @@ struct Coordinator::Impl {
   [[nodiscard]] uint64_t change_phase(JobState& job, JobPhase to, const std::string& error = "");
   /// Under `mu`: appends a job's phase (times, error) to the group commit; its ticket.
   [[nodiscard]] uint64_t append_phase(const JobState& job);
-  /// Under `mu`: a job that ended writes its image, drops its film and (with `notify`) has its
-  /// webhook called.
+  /// Under `mu`: a job that ended has its sums checkpointed and its image written in the
+  /// background (off the lock); then its film is dropped and (with `notify`) its webhook called.
+  /// An image a full disk kept from being written is tried again by the retention pass.
   void finish_job(JobState& job, bool notify);
+  /// Under `mu`: the job's webhook, if it has one, with its status.
+  void send_webhook(const JobState& job);
   std::string image_path(uint64_t job) const;
   /// A job from its row (plan, phase, times), with no results yet.
   std::unique_ptr<JobState> job_from_row(const JobRow& row) const;
@@ -163,6 +167,9 @@ struct Coordinator::Impl {
   /// Under `mu`: 404 for a job that is not (or no longer) here, saying so if retention deleted it.
   Status missing_job(uint64_t id);
 
+  // Image writing (finish_job): after everything its tasks touch, before `commits`, whose last
+  // callbacks may still queue tasks.
+  BackgroundQueue background;
   // The last member: its writer stops (committing what is queued, and running those records'
   // callbacks under `mu`) before anything it touches is destroyed.
   GroupCommit commits{store,

@@ -455,25 +455,37 @@ Status Coordinator::set_priority(uint64_t id, int priority) {
 
 Status Coordinator::retry_job(uint64_t id) {
   Impl& s = *impl_;
-  std::unique_lock<std::mutex> lock(s.mu);
-  auto it = s.jobs.find(id);
-  if (it == s.jobs.end()) return unknown_job(id);
-  JobState& old = *it->second;
-  if (old.phase != JobPhase::Failed && old.phase != JobPhase::Cancelled)
+  auto not_ended = [id](JobPhase phase) {
     return make_error(Code::Conflict, "job_not_ended",
-                      "job " + std::to_string(id) + " is " + phase_name(old.phase) + "; only failed or cancelled jobs are retried");
+                      "job " + std::to_string(id) + " is " + phase_name(phase) + "; only failed or cancelled jobs are retried");
+  };
+  JobRow row;
+  {
+    std::lock_guard<std::mutex> lock(s.mu);
+    auto it = s.jobs.find(id);
+    if (it == s.jobs.end()) return unknown_job(id);
+    const JobState& old = *it->second;
+    if (old.phase != JobPhase::Failed && old.phase != JobPhase::Cancelled) return not_ended(old.phase);
+    row = JobRow{id, old.name(), to_json(old.plan()).dump(), phase_name(old.phase), old.error, old.priority(),
+                 old.created(), old.started, old.finished};
+  }
+  // The passes it has stay: the job is rebuilt from its checkpoints and results (film included),
+  // reading and decoding them off the lock.
+  std::unique_ptr<JobState> job;
   try {
-    // The passes it has stay: the job is rebuilt from its stored results, film included.
-    JobRow row{id, old.name(), to_json(old.plan()).dump(), phase_name(old.phase), old.error, old.priority(),
-               old.created(), old.started, old.finished};
-    auto job = s.rebuild_job(row);
-    const uint64_t ticket = s.change_phase(*job, JobPhase::Queued);
-    it->second = std::move(job);
-    lock.unlock();
-    return s.durable(ticket);
+    job = s.rebuild_job(row);
   } catch (const std::exception& e) {
     return internal_error(e);
   }
+  std::unique_lock<std::mutex> lock(s.mu);
+  auto it = s.jobs.find(id);
+  if (it == s.jobs.end()) return unknown_job(id);
+  if (it->second->phase != JobPhase::Failed && it->second->phase != JobPhase::Cancelled)
+    return not_ended(it->second->phase);  // (retried by another request meanwhile)
+  const uint64_t ticket = s.change_phase(*job, JobPhase::Queued);
+  it->second = std::move(job);
+  lock.unlock();
+  return s.durable(ticket);
 }
 
 }  // namespace tessera::server

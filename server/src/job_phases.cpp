@@ -65,13 +65,7 @@ uint64_t Coordinator::Impl::change_phase(JobState& job, JobPhase to, const std::
   if (is_terminal(to)) end_leases_if([&](const LeaseInfo& l) { return l.job == job.id(); });
   log_change(job, to);
   work_cv.notify_all();
-  // (A full disk can stop the image here: the job has ended all the same, and the retention pass
-  // writes the image later from the film it keeps until then.)
-  if (is_terminal(to)) try {
-      finish_job(job, /*notify=*/true);
-    } catch (const std::exception& e) {
-      spdlog::warn("job {}: image not written yet: {}", job.id(), e.what());
-    }
+  if (is_terminal(to)) finish_job(job, /*notify=*/true);
   return ticket;
 }
 

@@ -159,6 +159,7 @@ class JobState {
   uint64_t mismatched = 0;  // duplicates whose sums differed from the accepted result's
   uint64_t result_bytes = 0;  // compressed bytes of the accepted results (the network cost)
   uint64_t lease_bytes = 0;   // JSON bytes of the leases handed out
+  bool image_pending = false;  // an ended job's image is being written (its film is kept until then)
 
  private:
   uint64_t id_;

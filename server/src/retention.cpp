@@ -83,12 +83,7 @@ json Coordinator::Impl::run_retention(double now) {
     std::lock_guard<std::mutex> lock(mu);
     // Images a full disk kept from being written: the job ended, its film is still in memory.
     for (auto& [id, job] : jobs)
-      if (is_terminal(job->phase) && job->has_film()) try {
-          finish_job(*job, /*notify=*/true);
-          log_event(spdlog::level::info, "job.image_saved", {{"job", id}});
-        } catch (const std::exception& e) {
-          spdlog::warn("job {}: image still not written: {}", id, e.what());
-        }
+      if (is_terminal(job->phase) && job->has_film()) finish_job(*job, /*notify=*/true);
     std::vector<uint64_t> unmeasured;
     for (auto& [id, job] : jobs)
       if (!is_terminal(job->phase) || !retention.finished_result_bytes.count(id)) unmeasured.push_back(id);
