@@ -212,6 +212,17 @@ bool lease_from_json(const json& j, Lease& out, std::string& error) {
   return job_settings_from_json(settings, out.settings, error);
 }
 
+json to_json(const Registration& r) {
+  return {{"id", r.id}, {"lease_timeout", r.lease_timeout}, {"heartbeat_seconds", r.heartbeat_seconds},
+          {"max_poll_wait", r.max_poll_wait}};
+}
+
+json to_json(const ResultAck& a) {
+  json j = {{"accepted", a.accepted}, {"duplicate", a.duplicate}};
+  if (a.next_asked) j["lease"] = a.next ? to_json(*a.next) : json(nullptr);
+  return j;
+}
+
 json to_json(const WorkerHello& h) {
   return {{"name", h.name},       {"threads", h.threads}, {"memory_bytes", h.memory_bytes},
           {"version", h.version}, {"isa", h.isa},         {"probe", h.probe}};

@@ -8,6 +8,7 @@
 #include "job_state.h"
 #include "metrics.h"
 #include "retention.h"
+#include "retention_plan.h"
 #include "scheduler.h"
 #include "webhooks.h"
 #include "worker_state.h"
@@ -19,6 +20,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <filesystem>
 #include <map>
 #include <mutex>
 #include <thread>
@@ -88,7 +90,7 @@ struct Coordinator::Impl {
   /// Under `mu`: records a lease of the chosen unit and appends it to the log (the job starts with
   /// its first); the caller hands it out once `ticket` is durable, or ends it (end_lease_id).
   struct IssuedLease {
-    nlohmann::json body;
+    Lease lease;
     uint64_t id = 0, ticket = 0;
   };
   IssuedLease issue_lease(uint64_t worker, WorkerInfo& w, const UnitChoice& choice);
@@ -162,8 +164,18 @@ struct Coordinator::Impl {
   nlohmann::json status_json(const JobState& job);
   /// Expires leases and marks silent workers lost, once a second.
   void reap_loop();
-  /// A retention pass (retention.cpp); takes `mu` itself and deletes files outside it.
+  /// A retention pass (retention.cpp): a snapshot under `mu`, files measured off it, the plan
+  /// (retention_plan.h, pure), rows deleted and bundles renamed away under `mu`, files removed after.
   nlohmann::json run_retention(double now);
+  std::optional<std::vector<RetentionJob>> retention_snapshot();
+  std::map<std::string, RetentionBundle> measure_retention_files(std::vector<RetentionJob>& snapshot);
+  nlohmann::json carry_out_retention(const RetentionPlan& plan, const std::vector<RetentionJob>& snapshot,
+                                     const std::map<std::string, RetentionBundle>& bundles, double now);
+  /// Under `mu`: false when the store refused (the pass stops there).
+  bool delete_expired_job(const RetentionJob& job, double now);
+  /// Under `mu`: renames the bundle and its folder into `trash`; false if a job uses it again.
+  bool move_expired_bundle(const std::string& hash, const RetentionBundle& bundle,
+                           std::vector<std::filesystem::path>& trash);
   /// Under `mu`: 404 for a job that is not (or no longer) here, saying so if retention deleted it.
   Status missing_job(uint64_t id);
 

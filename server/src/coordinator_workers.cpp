@@ -57,11 +57,8 @@ WorkerInfo* Coordinator::Impl::find_worker(uint64_t id) {
   return &w;
 }
 
-Result<json> Coordinator::register_worker(const json& body) {
+Result<Registration> Coordinator::register_worker(const WorkerHello& hello) {
   Impl& s = *impl_;
-  WorkerHello hello;
-  std::string error;
-  if (!worker_hello_from_json(body, hello, error)) return make_error(Code::BadRequest, "bad_registration", error);
   std::string mismatch =
       fingerprint_mismatch(s.fingerprint, BuildFingerprint{hello.version, hello.isa, hello.probe});
   if (!mismatch.empty()) {
@@ -77,10 +74,8 @@ Result<json> Coordinator::register_worker(const json& body) {
     w.last_seen = Clock::now();
     log_event(spdlog::level::info, "worker.registered",
               {{"worker", row.id}, {"name", hello.name}, {"threads", hello.threads}, {"isa", hello.isa}});
-    return json{{"id", row.id},
-                {"lease_timeout", s.opt.heartbeat_interval * kMissedHeartbeats},
-                {"heartbeat_seconds", s.opt.heartbeat_interval},
-                {"max_poll_wait", s.opt.max_poll_wait}};
+    return Registration{row.id, s.opt.heartbeat_interval * kMissedHeartbeats, s.opt.heartbeat_interval,
+                        s.opt.max_poll_wait};
   } catch (const std::exception& e) {
     return internal_error(e);
   }
@@ -142,8 +137,7 @@ Coordinator::Impl::IssuedLease Coordinator::Impl::issue_lease(uint64_t worker, W
   job.lease_started(unit);
   leases[l.id] = LeaseInfo{l.id, l.job_id, worker, unit, Clock::now() + dead_after()};
   set_worker_state(worker, w, WorkerState::Busy);
-  issued.body = to_json(l);
-  const size_t bytes = issued.body.dump().size();
+  const size_t bytes = to_json(l).dump().size();
   job.lease_bytes += bytes;
   counters.bytes_out += bytes;
   ++counters.leased;
@@ -151,10 +145,11 @@ Coordinator::Impl::IssuedLease Coordinator::Impl::issue_lease(uint64_t worker, W
   log_event(spdlog::level::debug, "lease.issued",
             {{"lease", l.id}, {"job", l.job_id}, {"tile", l.tile}, {"pass", l.pass}, {"worker", worker},
              {"speculative", choice.speculative}});
+  issued.lease = std::move(l);
   return issued;
 }
 
-Result<json> Coordinator::lease(uint64_t worker, double wait_seconds) {
+Result<std::optional<Lease>> Coordinator::lease(uint64_t worker, double wait_seconds) {
   Impl& s = *impl_;
   // Bounded: beyond this many waiting polls the answer is "nothing now" at once, so waiting
   // workers can never occupy every HTTP thread.
@@ -180,7 +175,7 @@ Result<json> Coordinator::lease(uint64_t worker, double wait_seconds) {
       lock.unlock();
       if (Status st = s.durable(issued.ticket); !st.ok()) return st;  // (its callback ended it)
       s.lease_wait.observe(std::chrono::duration<double>(Clock::now() - t0).count());
-      return std::move(issued.body);
+      return std::optional<Lease>(std::move(issued.lease));
     }
     if (Clock::now() >= deadline) break;
     s.update_busy(worker, *w);  // waiting for work with none in hand: idle, as the dashboard shows
@@ -189,20 +184,20 @@ Result<json> Coordinator::lease(uint64_t worker, double wait_seconds) {
   }
   s.update_busy(worker, *w);
   s.lease_wait.observe(std::chrono::duration<double>(Clock::now() - t0).count());
-  return json();
+  return std::optional<Lease>();
 }
 
-Result<json> Coordinator::heartbeat(uint64_t worker, const std::vector<HeldLease>& held) {
+Result<std::vector<uint64_t>> Coordinator::heartbeat(uint64_t worker, const std::vector<HeldLease>& held) {
   Impl& s = *impl_;
   std::lock_guard<std::mutex> lock(s.mu);
   WorkerInfo* w = s.find_worker(worker);
   if (!w) return unknown_worker(worker);
   s.saw_worker(worker, *w);
-  json drop = json::array();
+  std::vector<uint64_t> drop;
   for (const HeldLease& l : held)
     if (!s.keep_lease(worker, l)) drop.push_back(l.id);
   s.update_busy(worker, *w);
-  return json{{"drop", drop}};
+  return drop;
 }
 
 bool Coordinator::Impl::keep_lease(uint64_t worker, const HeldLease& held) {
@@ -307,7 +302,7 @@ std::optional<Coordinator::Impl::IssuedLease> Coordinator::Impl::next_lease(uint
   return issue_lease(worker, *w, *choice);
 }
 
-Result<json> Coordinator::upload_result(uint64_t worker, uint64_t /*lease*/, std::string_view bytes, bool next) {
+Result<ResultAck> Coordinator::upload_result(uint64_t worker, uint64_t /*lease*/, std::string_view bytes, bool next) {
   Impl& s = *impl_;
   const auto t0 = Clock::now();
   auto result = std::make_shared<TileResult>();
@@ -315,8 +310,8 @@ Result<json> Coordinator::upload_result(uint64_t worker, uint64_t /*lease*/, std
   if (!decode_tile_result(bytes, *result, error, s.opt.limits.max_pixels))
     return make_error(Code::BadRequest, "bad_result", error);
   // Decided here and appended to the group commit; its callback adds it to the job once durable.
+  ResultAck ack{/*accepted=*/true, /*duplicate=*/false, next, std::nullopt};
   uint64_t ticket = 0;
-  bool duplicate = false;
   std::optional<Impl::IssuedLease> issued;
   {
     std::lock_guard<std::mutex> lock(s.mu);
@@ -328,33 +323,28 @@ Result<json> Coordinator::upload_result(uint64_t worker, uint64_t /*lease*/, std
     if (job.is_done(unit) && job.accepted_from(unit) == worker) {
       // The same worker again: a retry of an upload whose answer was lost (the coordinator
       // restarted, or the connection broke), not a second render. Answered as it was the first time.
-      if (next) issued = s.next_lease(worker);
-      if (!issued) return json{{"accepted", true}, {"duplicate", false}, {"lease", nullptr}};
-      ticket = issued->ticket;
     } else if (job.is_done(unit) || job.is_committing(unit)) {
       s.check_duplicate(job, unit, worker, result->film);
-      duplicate = true;
-      if (next) issued = s.next_lease(worker);
-      if (!issued) return json{{"accepted", false}, {"duplicate", true}, {"lease", nullptr}};
-      ticket = issued->ticket;
+      ack.accepted = false;
+      ack.duplicate = true;
     } else {
       ticket = s.commit_result(job, unit, worker, result, bytes);
-      if (next) issued = s.next_lease(worker);  // (logged after the result: one commit for both)
     }
+    if (next) issued = s.next_lease(worker);  // (logged after the result: one commit for both)
   }
-  if (Status st = s.durable(ticket); !st.ok()) {
+  if (Status st = ticket ? s.durable(ticket) : Status::success(); !st.ok()) {
     if (issued) {  // (its own batch may have committed: the worker will not get it, so it ends)
       std::lock_guard<std::mutex> lock(s.mu);
       s.end_lease_id(issued->id);
     }
     return st;
   }
-  if (issued && !duplicate)
+  if (issued) {
     if (Status st = s.durable(issued->ticket); !st.ok()) return st;
+    ack.next = std::move(issued->lease);
+  }
   s.upload_seconds.observe(std::chrono::duration<double>(Clock::now() - t0).count());
-  json reply = {{"accepted", !duplicate}, {"duplicate", duplicate}};
-  if (next) reply["lease"] = issued ? std::move(issued->body) : json(nullptr);
-  return reply;
+  return ack;
 }
 
 void Coordinator::Impl::check_duplicate(JobState& job, size_t unit, uint64_t worker, const FilmTile& film) {
@@ -369,11 +359,9 @@ void Coordinator::Impl::check_duplicate(JobState& job, size_t unit, uint64_t wor
             {{"job", job.id()}, {"tile", job.tile_of(unit)}, {"pass", job.pass_of(unit)}, {"worker", worker}});
 }
 
-Status Coordinator::fail_lease(uint64_t worker, uint64_t lease, const json& body) {
+Status Coordinator::fail_lease(uint64_t worker, uint64_t lease, const std::string& error) {
   Impl& s = *impl_;
-  std::string reason = body.is_object() && body.contains("error") && body["error"].is_string()
-                           ? body["error"].get<std::string>().substr(0, 2000)
-                           : "unspecified";
+  const std::string reason = error.substr(0, 2000);
   std::unique_lock<std::mutex> lock(s.mu);
   auto it = s.leases.find(lease);
   if (it == s.leases.end() || it->second.worker != worker)
@@ -399,7 +387,7 @@ Status Coordinator::fail_lease(uint64_t worker, uint64_t lease, const json& body
   return s.durable(ticket);
 }
 
-Status Coordinator::sign_off(uint64_t worker, const json& body) {
+Status Coordinator::sign_off(uint64_t worker) {
   Impl& s = *impl_;
   uint64_t ticket = 0;
   {
@@ -412,7 +400,6 @@ Status Coordinator::sign_off(uint64_t worker, const json& body) {
                               GroupCommit::Retry::UntilDurable);
     log_event(spdlog::level::info, "worker.signed_off", {{"worker", worker}});
   }
-  (void)body;
   return s.durable(ticket);
 }
 

@@ -97,10 +97,17 @@ void normalise_body_headers(httplib::Request& req) {
   }
 }
 
+// A service's answer as JSON: the protocol types' to_json (farm/protocol.h), or JSON already.
+const json& as_json(const json& j) { return j; }
+template <class T>
+json as_json(const T& value) {
+  return to_json(value);
+}
+
 template <class T>
 void send(httplib::Response& res, const Result<T>& r, int ok_status = 200) {
   if (!r.ok()) return send_error(res, r.status);
-  send_json(res, ok_status, r.value);
+  send_json(res, ok_status, as_json(r.value));
 }
 
 void send(httplib::Response& res, const Status& s, int ok_status = 200) {
@@ -241,20 +248,25 @@ void install_routes(httplib::Server& http, Coordinator& c, uint64_t max_upload_b
   });
   http.Post("/api/v1/workers", [&c](const httplib::Request& req, httplib::Response& res) {
     json body;
-    if (parse_body(req, res, body)) send(res, c.register_worker(body), 201);
+    if (!parse_body(req, res, body)) return;
+    WorkerHello hello;
+    std::string error;
+    if (!worker_hello_from_json(body, hello, error))
+      return send_error(res, make_error(Code::BadRequest, "bad_registration", error));
+    send(res, c.register_worker(hello), 201);
   });
   http.Get("/api/v1/workers", [&c](const httplib::Request&, httplib::Response& res) { send(res, c.list_workers()); });
   http.Post(R"(/api/v1/workers/(\d+)/lease)", [&c](const httplib::Request& req, httplib::Response& res) {
     uint64_t id;
     if (!parse_id(req, 1, id, res)) return;
-    Result<json> lease = c.lease(id, query_number(req, "wait", 0));
+    Result<std::optional<Lease>> lease = c.lease(id, query_number(req, "wait", 0));
     if (!lease.ok()) return send_error(res, lease.status);
-    if (lease.value.is_null()) {
+    if (!lease.value) {
       res.status = 204;
       res.set_header("Retry-After", "1");
       return;
     }
-    send_json(res, 200, lease.value, /*compact=*/true);
+    send_json(res, 200, to_json(*lease.value), /*compact=*/true);
   });
   http.Post(R"(/api/v1/workers/(\d+)/heartbeat)", [&c](const httplib::Request& req, httplib::Response& res) {
     uint64_t id;
@@ -264,7 +276,9 @@ void install_routes(httplib::Server& http, Coordinator& c, uint64_t max_upload_b
     std::string error;
     if (!heartbeat_from_json(body, held, error))
       return send_error(res, make_error(Code::BadRequest, "bad_heartbeat", error));
-    send(res, c.heartbeat(id, held));
+    Result<std::vector<uint64_t>> drop = c.heartbeat(id, held);
+    if (!drop.ok()) return send_error(res, drop.status);
+    send_json(res, 200, json{{"drop", drop.value}});
   });
   http.Post(R"(/api/v1/workers/(\d+)/results)", [&c](const httplib::Request& req, httplib::Response& res) {
     uint64_t id;
@@ -274,13 +288,14 @@ void install_routes(httplib::Server& http, Coordinator& c, uint64_t max_upload_b
   http.Post(R"(/api/v1/workers/(\d+)/leases/(\d+)/fail)", [&c](const httplib::Request& req, httplib::Response& res) {
     uint64_t id, lease;
     json body;
-    if (parse_id(req, 1, id, res) && parse_id(req, 2, lease, res) && parse_body(req, res, body))
-      send(res, c.fail_lease(id, lease, body));
+    if (!parse_id(req, 1, id, res) || !parse_id(req, 2, lease, res) || !parse_body(req, res, body)) return;
+    const bool has_reason = body.is_object() && body.contains("error") && body["error"].is_string();
+    send(res, c.fail_lease(id, lease, has_reason ? body["error"].get<std::string>() : "unspecified"));
   });
   http.Delete(R"(/api/v1/workers/(\d+))", [&c](const httplib::Request& req, httplib::Response& res) {
     uint64_t id;
     json body;
-    if (parse_id(req, 1, id, res) && parse_body(req, res, body)) send(res, c.sign_off(id, body));
+    if (parse_id(req, 1, id, res) && parse_body(req, res, body)) send(res, c.sign_off(id));
   });
 
   // Errors httplib produces itself (no route: 404; a body over max_body_bytes, which it reads and

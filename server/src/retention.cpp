@@ -1,4 +1,5 @@
 #include "retention.h"
+#include "retention_plan.h"
 
 #include "coordinator_impl.h"
 #include "disk_full.h"
@@ -12,7 +13,6 @@
 #include <atomic>
 #include <ctime>
 #include <filesystem>
-#include <set>
 
 namespace tessera::server {
 
@@ -42,21 +42,6 @@ std::string utc(double t) {
   return buf;
 }
 
-struct JobInfo {
-  uint64_t id = 0;
-  bool finished = false;
-  double ended = 0;
-  std::string scene;
-  uint64_t bytes = 0;  // stored results + image
-};
-
-struct BundleInfo {
-  uint64_t bytes = 0;  // bundle file + unpacked folder
-  double last_use = 0;
-  int refs = 0;  // jobs that reference it
-  bool live = false;  // referenced by a queued or running job
-};
-
 }  // namespace
 
 bool touch_bundle(const std::string& path) {
@@ -76,50 +61,46 @@ Status Coordinator::Impl::missing_job(uint64_t id) {
   return unknown_job(id);
 }
 
-json Coordinator::Impl::run_retention(double now) {
-  const double max_age = opt.retain_days * 86400.0;
-  std::vector<JobInfo> snapshot;
-  {
-    std::lock_guard<std::mutex> lock(mu);
-    // Images a full disk kept from being written: the job ended, its film is still in memory.
-    for (auto& [id, job] : jobs)
-      if (is_terminal(job->phase) && job->has_film()) finish_job(*job, /*notify=*/true);
-    std::vector<uint64_t> unmeasured;
-    for (auto& [id, job] : jobs)
-      if (!is_terminal(job->phase) || !retention.finished_result_bytes.count(id)) unmeasured.push_back(id);
-    try {
-      // Once (at start-up) every job is unmeasured: one grouped query instead of one per job.
-      auto sizes = unmeasured.size() == jobs.size() ? store.result_bytes() : store.result_bytes(unmeasured);
-      std::map<uint64_t, uint64_t> measured(sizes.begin(), sizes.end());
-      for (uint64_t id : unmeasured) {
-        const bool finished = is_terminal(jobs.at(id)->phase);
-        if (finished) retention.finished_result_bytes[id] = measured[id];
-        else retention.finished_result_bytes.erase(id);  // (retried: measured again when it ends)
-      }
-      for (auto& [id, job] : jobs) {
-        const bool finished = is_terminal(job->phase);
-        snapshot.push_back({id, finished, job->finished > 0 ? job->finished : job->created(), job->plan().settings.scene,
-                            finished ? retention.finished_result_bytes[id] : measured[id]});
-      }
-    } catch (const std::exception& e) {
-      spdlog::warn("retention: cannot measure stored results: {}", e.what());
-      return json{{"error", e.what()}};
+std::optional<std::vector<RetentionJob>> Coordinator::Impl::retention_snapshot() {
+  std::lock_guard<std::mutex> lock(mu);
+  // Images a full disk kept from being written: the job ended, its film is still in memory.
+  for (auto& [id, job] : jobs)
+    if (is_terminal(job->phase) && job->has_film()) finish_job(*job, /*notify=*/true);
+  std::vector<uint64_t> unmeasured;
+  for (auto& [id, job] : jobs)
+    if (!is_terminal(job->phase) || !retention.finished_result_bytes.count(id)) unmeasured.push_back(id);
+  std::vector<RetentionJob> snapshot;
+  try {
+    // Once (at start-up) every job is unmeasured: one grouped query instead of one per job.
+    auto sizes = unmeasured.size() == jobs.size() ? store.result_bytes() : store.result_bytes(unmeasured);
+    std::map<uint64_t, uint64_t> measured(sizes.begin(), sizes.end());
+    for (uint64_t id : unmeasured) {
+      if (is_terminal(jobs.at(id)->phase)) retention.finished_result_bytes[id] = measured[id];
+      else retention.finished_result_bytes.erase(id);  // (retried: measured again when it ends)
     }
+    for (auto& [id, job] : jobs) {
+      const bool finished = is_terminal(job->phase);
+      snapshot.push_back({id, finished, job->finished > 0 ? job->finished : job->created(), job->plan().settings.scene,
+                          finished ? retention.finished_result_bytes[id] : measured[id]});
+    }
+  } catch (const std::exception& e) {
+    spdlog::warn("retention: cannot measure stored results: {}", e.what());
+    return std::nullopt;
   }
+  return snapshot;
+}
 
-  // Measure the files (outside the lock).
+std::map<std::string, RetentionBundle> Coordinator::Impl::measure_retention_files(std::vector<RetentionJob>& snapshot) {
   std::error_code ec;
-  uint64_t total = 0;
-  for (JobInfo& j : snapshot) {
+  for (RetentionJob& j : snapshot) {
     const uintmax_t image = fs::file_size(image_path(j.id), ec);
     if (!ec) j.bytes += image;
-    total += j.bytes;
   }
-  std::map<std::string, BundleInfo> bundles;
+  std::map<std::string, RetentionBundle> bundles;
   for (auto it = fs::directory_iterator(fs::path(opt.data_dir) / "bundles", ec); !ec && it != fs::directory_iterator();
        it.increment(ec)) {
     if (it->path().extension() != ".bundle") continue;
-    BundleInfo& b = bundles[it->path().stem().string()];
+    RetentionBundle& b = bundles[it->path().stem().string()];
     b.bytes += it->file_size(ec);
     b.last_use = std::max(b.last_use, to_wall(it->last_write_time(ec)));
   }
@@ -129,108 +110,39 @@ json Coordinator::Impl::run_retention(double now) {
     if (name.find('.') != std::string::npos || !it->is_directory(ec)) continue;  // (.tmp-/.old- of an unpack in flight)
     bundles[name].bytes += tree_bytes(it->path());
   }
-  for (auto& [hash, b] : bundles) total += b.bytes;
-  for (const JobInfo& j : snapshot) {
-    auto b = bundles.find(j.scene);
-    if (b == bundles.end()) continue;
-    ++b->second.refs;
-    b->second.live |= !j.finished;
-    if (j.finished) b->second.last_use = std::max(b->second.last_use, j.ended);
-  }
+  return bundles;
+}
 
-  // Decide: the age limit first, then the oldest finished jobs and unused bundles until under the size.
-  std::set<uint64_t> doomed_jobs;
-  std::set<std::string> doomed_bundles;
-  uint64_t remaining = total;
-  auto drop_job = [&](const JobInfo& j) {
-    doomed_jobs.insert(j.id);
-    remaining -= j.bytes;
-    if (auto b = bundles.find(j.scene); b != bundles.end()) --b->second.refs;
-  };
-  auto drop_bundle = [&](const std::string& hash) {
-    doomed_bundles.insert(hash);
-    remaining -= bundles[hash].bytes;
-  };
-  std::vector<const JobInfo*> finished;
-  for (const JobInfo& j : snapshot)
-    if (j.finished) finished.push_back(&j);
-  std::sort(finished.begin(), finished.end(), [](const JobInfo* a, const JobInfo* b) {
-    return a->ended != b->ended ? a->ended < b->ended : a->id < b->id;
-  });
-  if (max_age > 0) {
-    for (const JobInfo* j : finished)
-      if (now - j->ended > max_age) drop_job(*j);
-    for (auto& [hash, b] : bundles)
-      if (b.refs == 0 && now - b.last_use > max_age) drop_bundle(hash);
-  }
-  if (opt.retain_bytes > 0 && remaining > opt.retain_bytes) {
-    size_t next_job = 0;
-    while (remaining > opt.retain_bytes) {
-      while (next_job < finished.size() && doomed_jobs.count(finished[next_job]->id)) ++next_job;
-      const std::string* oldest_bundle = nullptr;
-      for (auto& [hash, b] : bundles)
-        if (!doomed_bundles.count(hash) && b.refs == 0 && now - b.last_use > kBundleGraceSeconds &&
-            (!oldest_bundle || b.last_use < bundles[*oldest_bundle].last_use))
-          oldest_bundle = &hash;
-      const JobInfo* job = next_job < finished.size() ? finished[next_job] : nullptr;
-      if (oldest_bundle && (!job || bundles[*oldest_bundle].last_use <= job->ended)) drop_bundle(*oldest_bundle);
-      else if (job) drop_job(*job);
-      else break;
-    }
-    if (remaining > opt.retain_bytes)
-      spdlog::warn("retention: the data dir holds {} bytes of queued, running or recent work, over --retain-bytes {}",
-                   remaining, opt.retain_bytes);
-  }
+json Coordinator::Impl::run_retention(double now) {
+  std::optional<std::vector<RetentionJob>> snapshot = retention_snapshot();
+  if (!snapshot) return json{{"error", "cannot measure stored results"}};
+  const std::map<std::string, RetentionBundle> bundles = measure_retention_files(*snapshot);  // (off the lock)
+  const RetentionPlan plan =
+      plan_retention(*snapshot, bundles, {opt.retain_days * 86400.0, opt.retain_bytes, kBundleGraceSeconds}, now);
+  if (opt.retain_bytes > 0 && plan.remaining > opt.retain_bytes)
+    spdlog::warn("retention: the data dir holds {} bytes of queued, running or recent work, over --retain-bytes {}",
+                 plan.remaining, opt.retain_bytes);
+  return carry_out_retention(plan, *snapshot, bundles, now);
+}
 
-  // Delete: rows under the lock, files after it.
-  std::vector<std::string> doomed_files;
-  std::vector<fs::path> trash;
+json Coordinator::Impl::carry_out_retention(const RetentionPlan& plan, const std::vector<RetentionJob>& snapshot,
+                                            const std::map<std::string, RetentionBundle>& bundles, double now) {
+  std::vector<fs::path> trash;  // removed after the lock: images, renamed bundles and scene folders
   uint64_t deleted_jobs = 0, deleted_bundles = 0, freed = 0;
   {
     std::lock_guard<std::mutex> lock(mu);
-    for (const JobInfo& j : snapshot) {
-      if (!doomed_jobs.count(j.id)) continue;
-      auto it = jobs.find(j.id);
-      // Retried (queued again) since the snapshot: not finished any more.
-      if (it == jobs.end() || !is_terminal(it->second->phase) ||
-          (it->second->finished > 0 ? it->second->finished : it->second->created()) != j.ended)
-        continue;
-      try {
-        store.delete_job(j.id, now);
-      } catch (const std::exception& e) {
-        spdlog::warn("retention: cannot delete job {}: {}", j.id, e.what());
-        break;
-      }
-      end_leases_if([&](const LeaseInfo& l) { return l.job == j.id; });
-      jobs.erase(it);
-      retention.finished_result_bytes.erase(j.id);
-      doomed_files.push_back(image_path(j.id));
+    for (uint64_t id : plan.jobs) {
+      const RetentionJob& j = *std::find_if(snapshot.begin(), snapshot.end(), [id](auto& s) { return s.id == id; });
+      if (!delete_expired_job(j, now)) break;
+      trash.push_back(image_path(id));
       ++deleted_jobs;
       freed += j.bytes;
-      log_event(spdlog::level::info, "job.expired", {{"job", j.id}, {"bytes", j.bytes}});
     }
-    static std::atomic<uint64_t> trash_counter{0};
-    for (const std::string& hash : doomed_bundles) {
-      bool referenced = false;  // by a job submitted since the snapshot
-      for (auto& [id, job] : jobs) referenced |= job->plan().settings.scene == hash;
-      const fs::path file = bundle_path(hash);
-      if (referenced || (fs::exists(file, ec) && to_wall(fs::last_write_time(file, ec)) > bundles[hash].last_use)) continue;
-      // Renamed away under the lock: a submission finds the bundle whole or not at all.
-      const std::string tag = std::to_string(::getpid()) + "-" + std::to_string(++trash_counter);
-      for (const fs::path& p : {file, fs::path(scene_dir(hash))}) {
-        if (!fs::exists(p, ec)) continue;
-        const fs::path to = fs::path(opt.data_dir) / "tmp" / ("expired-" + tag + "-" + p.filename().string());
-        fs::rename(p, to, ec);
-        if (!ec) trash.push_back(to);
+    for (const std::string& hash : plan.bundles)
+      if (move_expired_bundle(hash, bundles.at(hash), trash)) {
+        ++deleted_bundles;
+        freed += bundles.at(hash).bytes;
       }
-      try {
-        store.delete_scene(hash);
-      } catch (const std::exception&) {
-      }
-      ++deleted_bundles;
-      freed += bundles[hash].bytes;
-      log_event(spdlog::level::info, "bundle.expired", {{"scene", hash}, {"bytes", bundles[hash].bytes}});
-    }
     if (deleted_jobs > 0) try {
         store.incremental_vacuum();
       } catch (const std::exception& e) {
@@ -239,13 +151,55 @@ json Coordinator::Impl::run_retention(double now) {
     retention.deleted_jobs += deleted_jobs;
     retention.deleted_bundles += deleted_bundles;
     retention.freed_bytes += freed;
-    retention.data_bytes = total >= freed ? total - freed : 0;
+    retention.data_bytes = plan.total >= freed ? plan.total - freed : 0;
     ++retention.passes;
   }
-  for (const std::string& f : doomed_files) fs::remove(f, ec);
+  std::error_code ec;
   for (const fs::path& p : trash) fs::remove_all(p, ec);
   return json{{"deleted_jobs", deleted_jobs}, {"deleted_bundles", deleted_bundles}, {"freed_bytes", freed},
-              {"data_bytes", total >= freed ? total - freed : 0}};
+              {"data_bytes", plan.total >= freed ? plan.total - freed : 0}};
+}
+
+bool Coordinator::Impl::delete_expired_job(const RetentionJob& j, double now) {
+  auto it = jobs.find(j.id);
+  // Retried (queued again) since the snapshot: not finished any more.
+  if (it == jobs.end() || !is_terminal(it->second->phase) ||
+      (it->second->finished > 0 ? it->second->finished : it->second->created()) != j.ended)
+    return true;
+  try {
+    store.delete_job(j.id, now);
+  } catch (const std::exception& e) {
+    spdlog::warn("retention: cannot delete job {}: {}", j.id, e.what());
+    return false;
+  }
+  end_leases_if([&](const LeaseInfo& l) { return l.job == j.id; });
+  jobs.erase(it);
+  retention.finished_result_bytes.erase(j.id);
+  log_event(spdlog::level::info, "job.expired", {{"job", j.id}, {"bytes", j.bytes}});
+  return true;
+}
+
+bool Coordinator::Impl::move_expired_bundle(const std::string& hash, const RetentionBundle& b, std::vector<fs::path>& trash) {
+  static std::atomic<uint64_t> trash_counter{0};
+  bool referenced = false;  // by a job submitted since the snapshot
+  for (auto& [id, job] : jobs) referenced |= job->plan().settings.scene == hash;
+  std::error_code ec;
+  const fs::path file = bundle_path(hash);
+  if (referenced || (fs::exists(file, ec) && to_wall(fs::last_write_time(file, ec)) > b.last_use)) return false;
+  // Renamed away under the lock: a submission finds the bundle whole or not at all.
+  const std::string tag = std::to_string(::getpid()) + "-" + std::to_string(++trash_counter);
+  for (const fs::path& p : {file, fs::path(scene_dir(hash))}) {
+    if (!fs::exists(p, ec)) continue;
+    const fs::path to = fs::path(opt.data_dir) / "tmp" / ("expired-" + tag + "-" + p.filename().string());
+    fs::rename(p, to, ec);
+    if (!ec) trash.push_back(to);
+  }
+  try {
+    store.delete_scene(hash);
+  } catch (const std::exception&) {
+  }
+  log_event(spdlog::level::info, "bundle.expired", {{"scene", hash}, {"bytes", b.bytes}});
+  return true;
 }
 
 Result<json> Coordinator::apply_retention(double now) {

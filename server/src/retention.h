@@ -4,14 +4,15 @@
 // references go too when they are older than the age limit or are needed to get under the size.
 // Nothing of a queued or running job is ever touched.
 //
-// Size counted: stored result bytes (the compressed tile results in SQLite) + job images + bundle
-// files + unpacked scene folders. The SQLite file itself does not shrink in databases created
+// Size counted: stored checkpoints and result bytes (compressed tile sums in SQLite) + job images +
+// bundle files + unpacked scene folders. The SQLite file itself does not shrink in databases created
 // before retention existed: SQLite reuses the freed pages; new databases (auto_vacuum=INCREMENTAL)
 // give them back at the end of each pass.
 //
 // The pass (Coordinator::Impl::run_retention) runs from the reaper thread at start-up and then
 // every CoordinatorOptions::maintenance_interval seconds, and on Coordinator::apply_retention().
-// It decides under `mu`, deletes rows under `mu`, and deletes files outside it: bundle files and
+// It takes a snapshot of the jobs under `mu`, measures files off it, decides with a pure plan
+// (retention_plan.h), deletes rows under `mu`, and deletes files outside it: bundle files and
 // folders are renamed into data-dir/tmp under the lock (so a submission never sees half a bundle)
 // and removed after.
 #pragma once

@@ -31,9 +31,15 @@ inline std::string bundle() {
 
 inline uint64_t add_worker(server::Coordinator& c, const std::string& name) {
   const BuildFingerprint& fp = build_fingerprint();
-  auto r = c.register_worker(nlohmann::json{{"name", name}, {"version", fp.version}, {"isa", fp.isa}, {"probe", fp.probe}});
+  auto r = c.register_worker(WorkerHello{name, 1, 0, fp.version, fp.isa, fp.probe});
   EXPECT_TRUE(r.ok()) << r.status.detail;
-  return r.value.value("id", uint64_t(0));
+  return r.value.id;
+}
+
+// A lease as the API sends it (null when there was none): what the tests inspect.
+inline nlohmann::json lease_json(const server::Result<std::optional<Lease>>& r) {
+  EXPECT_TRUE(r.ok()) << r.status.detail;
+  return r.value ? to_json(*r.value) : nlohmann::json();
 }
 
 inline server::CoordinatorOptions options(const TempDir& dir) {
@@ -53,7 +59,7 @@ inline std::string render_unit(const nlohmann::json& lease_json, const Scene& sc
 
 // Leases and delivers one unit for real; false when there was nothing to lease.
 inline bool deliver_one(server::Coordinator& c, uint64_t worker, const Scene& scene, uint32_t seed) {
-  nlohmann::json l = c.lease(worker, 0).value;
+  nlohmann::json l = lease_json(c.lease(worker, 0));
   if (!l.is_object()) return false;
   auto up = c.upload_result(worker, l["id"], render_unit(l, scene, seed));
   EXPECT_TRUE(up.ok()) << up.status.detail;

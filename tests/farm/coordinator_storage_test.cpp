@@ -47,12 +47,12 @@ std::string synthetic_result(const json& lease_json) {
 
 // Delivers up to `units` units (with the next lease asked for each time); the units delivered.
 int deliver(Coordinator& c, uint64_t worker, int units) {
-  json lease = c.lease(worker, 0).value;
+  nlohmann::json lease = lease_json(c.lease(worker, 0));
   int done = 0;
   for (; done < units && lease.is_object(); ++done) {
     auto up = c.upload_result(worker, lease["id"], synthetic_result(lease), /*next=*/done + 1 < units);
     EXPECT_TRUE(up.ok()) << up.status.detail;
-    lease = up.value.value("lease", json());
+    lease = up.value.next ? to_json(*up.value.next) : json();
   }
   EXPECT_FALSE(lease.is_object() && done == units) << "a lease nobody asked for";
   return done;

@@ -60,19 +60,17 @@ CoordinatorOptions options(const TempDir& dir, double days, uint64_t bytes) {
 
 uint64_t add_worker(Coordinator& c) {
   const BuildFingerprint& fp = build_fingerprint();
-  auto r = c.register_worker(json{{"name", "w"}, {"version", fp.version}, {"isa", fp.isa}, {"probe", fp.probe}});
+  auto r = c.register_worker(WorkerHello{"w", 1, 0, fp.version, fp.isa, fp.probe});
   EXPECT_TRUE(r.ok()) << r.status.detail;
-  return r.value.value("id", uint64_t(0));
+  return r.value.id;
 }
 
 // Leases and delivers units of whatever job is first; false when there was nothing to lease.
 bool deliver_one(Coordinator& c, uint64_t worker, const TestScene& scene) {
-  json l = c.lease(worker, 0).value;
-  if (!l.is_object()) return false;
-  Lease lease;
-  std::string error;
-  EXPECT_TRUE(lease_from_json(l, lease, error)) << error;
-  auto up = c.upload_result(worker, lease.id, encode_tile_result(render_lease(*scene.loaded.scene, lease)));
+  auto l = c.lease(worker, 0);
+  EXPECT_TRUE(l.ok()) << l.status.detail;
+  if (!l.value) return false;
+  auto up = c.upload_result(worker, l.value->id, encode_tile_result(render_lease(*scene.loaded.scene, *l.value)));
   EXPECT_TRUE(up.ok()) << up.status.detail;
   return true;
 }

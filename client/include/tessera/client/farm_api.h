@@ -24,16 +24,8 @@ struct ApiReply {
   std::string describe() const { return error.empty() ? http.describe() : error; }
 };
 
-/// What the coordinator tells a worker at registration.
-struct Registration {
-  uint64_t id = 0;
-  double lease_timeout = 0, heartbeat_seconds = 0, max_poll_wait = 0;
-};
-
-struct ResultAck {
-  bool accepted = false, duplicate = false;
-  std::optional<Lease> next;  // asked for with the result (`want_next`): the worker's next unit
-};
+using tessera::Registration;  // (farm/protocol.h: the coordinator answers with these)
+using tessera::ResultAck;
 
 /// One of the worker's hot requests as plain HTTP pieces, for a caller with a transport of its own
 /// (the load benchmark's event loop); FarmApi sends exactly these.

@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -73,6 +74,25 @@ struct WorkerHello {
 
 nlohmann::json to_json(const WorkerHello& h);
 [[nodiscard]] bool worker_hello_from_json(const nlohmann::json& j, WorkerHello& out, std::string& error);
+
+/// What the coordinator tells a worker at registration.
+struct Registration {
+  uint64_t id = 0;
+  double lease_timeout = 0, heartbeat_seconds = 0, max_poll_wait = 0;
+};
+
+nlohmann::json to_json(const Registration& r);
+
+/// The answer to a tile result: accepted (stored, or the same worker's earlier copy was), or a
+/// duplicate of another worker's; with the worker's next lease when it asked for one ("lease", null
+/// when there is no work for it now).
+struct ResultAck {
+  bool accepted = false, duplicate = false;
+  bool next_asked = false;
+  std::optional<Lease> next;
+};
+
+nlohmann::json to_json(const ResultAck& a);
 
 /// A lease a worker still holds, as its heartbeat reports it ({"leases": [...]}).
 struct HeldLease {

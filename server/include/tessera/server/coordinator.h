@@ -93,20 +93,22 @@ class Coordinator {
   Status set_priority(uint64_t id, int priority);
   Status retry_job(uint64_t id);
 
-  // Workers.
-  Result<nlohmann::json> register_worker(const nlohmann::json& hello);
-  /// Waits up to `wait_seconds` (bounded by max_poll_wait) for work. A null json: nothing to do.
-  Result<nlohmann::json> lease(uint64_t worker, double wait_seconds);
+  // Workers: the farm's protocol types in and out (JSON is the HTTP layer's).
+  /// 409 for a build whose fingerprint differs from the coordinator's.
+  Result<Registration> register_worker(const WorkerHello& hello);
+  /// Waits up to `wait_seconds` (bounded by max_poll_wait) for work; nothing when there is none.
+  Result<std::optional<Lease>> lease(uint64_t worker, double wait_seconds);
   /// The leases the worker still holds: each is kept alive (or re-adopted after a restart); the
-  /// answer's "drop" lists those the coordinator no longer wants.
-  Result<nlohmann::json> heartbeat(uint64_t worker, const std::vector<HeldLease>& held);
+  /// answer lists those the coordinator no longer wants (to drop).
+  Result<std::vector<uint64_t>> heartbeat(uint64_t worker, const std::vector<HeldLease>& held);
   /// A tile result (tile_result.h bytes). Accepted once per unit: a duplicate is acknowledged and
   /// dropped. Valid without a live lease too (a worker finishing across a coordinator restart).
-  /// Answered once durable. With `next`, the answer also carries the worker's next lease ("lease",
-  /// null when there is no work it may take now), logged in the same commit as the result.
-  Result<nlohmann::json> upload_result(uint64_t worker, uint64_t lease, std::string_view bytes, bool next = false);
-  Status fail_lease(uint64_t worker, uint64_t lease, const nlohmann::json& body);
-  Status sign_off(uint64_t worker, const nlohmann::json& body);
+  /// Answered once durable. With `next`, the answer also carries the worker's next lease (none
+  /// when there is no work it may take now), logged in the same commit as the result.
+  Result<ResultAck> upload_result(uint64_t worker, uint64_t lease, std::string_view bytes, bool next = false);
+  /// The worker could not render the lease (`reason`, at most 2000 characters kept).
+  Status fail_lease(uint64_t worker, uint64_t lease, const std::string& reason);
+  Status sign_off(uint64_t worker);
   /// Draining: the worker finishes what it renders and gets no more work (its lease polls are
   /// answered 410, on which tessera-worker signs off and exits).
   Status drain_worker(uint64_t worker);
