@@ -6,6 +6,7 @@
 
 #include "tessera/client/farm_api.h"
 #include "tessera/farm/build_fingerprint.h"
+#include "tessera/farm/job_scene.h"
 #include "tessera/farm/tile_result.h"
 
 #include <arpa/inet.h>
@@ -33,13 +34,8 @@ double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std
 // Pixel sums with the size and entropy of a real pass (so the bytes on the wire and in the store
 // are realistic), for exactly the leased unit.
 void fill_synthetic(const Lease& lease, uint64_t& rng, TileResult& result) {
-  result.job_id = lease.job_id;
-  result.tile = lease.tile;
-  result.pass = lease.pass;
-  result.sample_begin = lease.sample_begin;
-  result.sample_end = lease.sample_end;
+  begin_tile_result(lease, result);
   result.seconds = 0.001;
-  result.film.reset(lease.rect);
   const uint32_t n = lease.sample_end - lease.sample_begin;
   for (PixelSums& p : result.film.mutable_pixels()) {
     for (int c = 0; c < 3; ++c) {

@@ -61,13 +61,19 @@ JobPlan make_job_plan(const std::string& bundle_dir, const std::string& scene_fi
   return plan;
 }
 
+void begin_tile_result(const Lease& lease, TileResult& out) {
+  out.job_id = lease.job_id;
+  out.tile = lease.tile;
+  out.pass = lease.pass;
+  out.sample_begin = lease.sample_begin;
+  out.sample_end = lease.sample_end;
+  out.seconds = 0;
+  out.film.reset(lease.rect);
+}
+
 TileResult render_lease(const Scene& scene, const Lease& lease) {
   TileResult result;
-  result.job_id = lease.job_id;
-  result.tile = lease.tile;
-  result.pass = lease.pass;
-  result.sample_begin = lease.sample_begin;
-  result.sample_end = lease.sample_end;
+  begin_tile_result(lease, result);
   const auto t0 = std::chrono::steady_clock::now();
   render_tile(scene, lease.rect, lease.sample_begin, lease.sample_end, lease.settings.seed, result.film);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -91,7 +91,7 @@ struct Coordinator::Impl {
   /// its first); the caller hands it out once `ticket` is durable, or ends it (end_lease_id).
   struct IssuedLease {
     Lease lease;
-    uint64_t id = 0, ticket = 0;
+    uint64_t ticket = 0;
   };
   IssuedLease issue_lease(uint64_t worker, WorkerInfo& w, const UnitChoice& choice);
   /// Under `mu`: a lease for a worker that asks for one without waiting (with its result), if

@@ -115,7 +115,7 @@ Coordinator::Impl::IssuedLease Coordinator::Impl::issue_lease(uint64_t worker, W
   // The job's first lease: its phase is logged ahead of the lease.
   if (job.phase == JobPhase::Queued) (void)change_phase(job, JobPhase::Running);
   Lease l;
-  l.id = issued.id = ++last_lease_id;
+  l.id = ++last_lease_id;
   l.job_id = job.id();
   l.tile = job.tile_of(unit);
   l.pass = job.pass_of(unit);
@@ -335,7 +335,7 @@ Result<ResultAck> Coordinator::upload_result(uint64_t worker, uint64_t /*lease*/
   if (Status st = ticket ? s.durable(ticket) : Status::success(); !st.ok()) {
     if (issued) {  // (its own batch may have committed: the worker will not get it, so it ends)
       std::lock_guard<std::mutex> lock(s.mu);
-      s.end_lease_id(issued->id);
+      s.end_lease_id(issued->lease.id);
     }
     return st;
   }

@@ -131,8 +131,10 @@ json Coordinator::Impl::carry_out_retention(const RetentionPlan& plan, const std
   uint64_t deleted_jobs = 0, deleted_bundles = 0, freed = 0;
   {
     std::lock_guard<std::mutex> lock(mu);
+    std::map<uint64_t, const RetentionJob*> by_id;
+    for (const RetentionJob& j : snapshot) by_id[j.id] = &j;
     for (uint64_t id : plan.jobs) {
-      const RetentionJob& j = *std::find_if(snapshot.begin(), snapshot.end(), [id](auto& s) { return s.id == id; });
+      const RetentionJob& j = *by_id.at(id);
       if (!delete_expired_job(j, now)) break;
       trash.push_back(image_path(id));
       ++deleted_jobs;

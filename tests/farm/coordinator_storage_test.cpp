@@ -24,12 +24,7 @@ std::string synthetic_result(const json& lease_json) {
   std::string error;
   EXPECT_TRUE(lease_from_json(lease_json, lease, error)) << error;
   TileResult r;
-  r.job_id = lease.job_id;
-  r.tile = lease.tile;
-  r.pass = lease.pass;
-  r.sample_begin = lease.sample_begin;
-  r.sample_end = lease.sample_end;
-  r.film.reset(lease.rect);
+  begin_tile_result(lease, r);
   uint64_t rng = 0x9E3779B97F4A7C15ull * (uint64_t(lease.tile) * 131 + lease.pass + 1);
   const uint32_t n = lease.sample_end - lease.sample_begin;
   for (PixelSums& p : r.film.mutable_pixels()) {

@@ -34,10 +34,10 @@ JobSettings many_units() {
 // What the workers were told: the encoded result of every unit the coordinator acknowledged.
 struct Acknowledged {
   std::mutex mu;
-  std::map<std::pair<uint32_t, uint32_t>, std::pair<uint64_t, std::string>> results;  // (tile, pass) -> worker, bytes
-  void add(uint64_t worker, const Lease& l, const std::string& bytes) {
+  std::map<std::pair<uint32_t, uint32_t>, std::string> results;  // (tile, pass) -> result bytes
+  void add(const Lease& l, const std::string& bytes) {
     std::lock_guard<std::mutex> lock(mu);
-    results.emplace(std::make_pair(l.tile, l.pass), std::make_pair(worker, bytes));
+    results.emplace(std::make_pair(l.tile, l.pass), bytes);
   }
   auto snapshot() {
     std::lock_guard<std::mutex> lock(mu);
@@ -79,7 +79,7 @@ void simulated_worker(const Farm& farm, const Scene& scene, int index, Control& 
     for (;;) {  // delivered even if the coordinator dies meanwhile
       auto r = api.upload_result(id, lease->id, bytes, 10, /*want_next=*/index % 2 == 0);
       if (r.ok()) {
-        acked.add(id, *lease, bytes);
+        acked.add(*lease, bytes);
         lease = std::move(r.value.next);
         break;
       }
@@ -134,8 +134,7 @@ TEST(FarmDurability, AcknowledgedResultsSurviveKillsUnderLoadAndTheImageIsBitExa
     const BuildFingerprint& fp = build_fingerprint();
     auto checker = api.register_worker(WorkerHello{"checker", 1, uint64_t(1) << 30, fp.version, fp.isa, fp.probe});
     ASSERT_TRUE(checker.ok()) << checker.describe();
-    for (const auto& [unit, delivered] : before) {
-      const std::string& bytes = delivered.second;
+    for (const auto& [unit, bytes] : before) {
       auto r = api.upload_result(checker.value.id, 0, bytes, 10);
       ASSERT_TRUE(r.ok()) << r.describe();
       EXPECT_TRUE(r.value.duplicate) << "tile " << unit.first << " pass " << unit.second

@@ -41,6 +41,9 @@ LoadedJobScene load_job_scene(const std::string& bundle_dir, const std::string& 
 JobPlan make_job_plan(const std::string& bundle_dir, const std::string& scene_file, const JobSettings& settings,
                       const LoadedJobScene& scene);
 
+/// Sets `out` to the lease's unit (job, tile, pass, samples) with a zero film of its rectangle,
+/// reusing its storage: a result about to be filled.
+void begin_tile_result(const Lease& lease, TileResult& out);
 /// Renders a lease's unit (what a worker does with it), timed.
 TileResult render_lease(const Scene& scene, const Lease& lease);
 
