@@ -3,11 +3,10 @@
 // their requests cost and not a thread each. Requests are the client library's (RequestSpec), one
 // connection each with "Connection: close", as tessera-worker's are.
 #include "farm_load.h"
+#include "synthetic_results.h"
 
 #include "tessera/client/farm_api.h"
 #include "tessera/farm/build_fingerprint.h"
-#include "tessera/farm/job_scene.h"
-#include "tessera/farm/tile_result.h"
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
@@ -30,25 +29,6 @@ using Clock = std::chrono::steady_clock;
 namespace {
 
 double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
-
-// Pixel sums with the size and entropy of a real pass (so the bytes on the wire and in the store
-// are realistic), for exactly the leased unit.
-void fill_synthetic(const Lease& lease, uint64_t& rng, TileResult& result) {
-  begin_tile_result(lease, result);
-  result.seconds = 0.001;
-  const uint32_t n = lease.sample_end - lease.sample_begin;
-  for (PixelSums& p : result.film.mutable_pixels()) {
-    for (int c = 0; c < 3; ++c) {
-      rng ^= rng << 13, rng ^= rng >> 7, rng ^= rng << 17;  // xorshift64
-      const double v = double(rng >> 11) * 0x1p-53;
-      p.sum[c] = v * n;
-      p.sum_sq[c] = v * v * n;
-    }
-    p.count = n;
-  }
-  result.film.counters.samples = uint64_t(lease.rect.area()) * n;
-  result.film.counters.camera_rays = result.film.counters.samples;
-}
 
 // "http://127.0.0.1:PORT" (the benchmark's own coordinator) as a socket address.
 sockaddr_in loopback_address(const std::string& url) {
@@ -121,7 +101,7 @@ class Loop {
   int ep_ = -1;
   size_t active_ = 0;
   std::multimap<Clock::time_point, Sim*> timers_;
-  TileResult scratch_;
+  SyntheticResults results_;
 };
 
 void Loop::send(Sim& s, client::RequestSpec r) {
@@ -209,11 +189,10 @@ void Loop::on_lease(Sim& s, client::HttpReply reply) {
 void Loop::upload(Sim& s, Lease lease) {
   ++stats_[size_t(s.index)].leased;
   // A lease taken is completed even when stopping: every unit leased must end accepted.
-  fill_synthetic(lease, s.rng, scratch_);
   s.kind = Sim::Kind::Upload;
   s.attempt = 0;
+  s.result = results_.encode(lease, s.rng);
   s.lease = std::move(lease);
-  s.result = encode_tile_result(scratch_);
   send_result(s);
 }
 

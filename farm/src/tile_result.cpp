@@ -57,6 +57,7 @@ std::string encode_tile_result(const TileResult& r, int level) {
   }
   Sha256Digest digest = sha256(raw);
   raw.append(reinterpret_cast<const char*>(digest.data()), digest.size());
+  if (level == kUncompressed) return raw;
 
   std::string out(ZSTD_compressBound(raw.size()), '\0');
   size_t n = ZSTD_compress(out.data(), out.size(), raw.data(), raw.size(), level);
@@ -64,21 +65,54 @@ std::string encode_tile_result(const TileResult& r, int level) {
   return out;
 }
 
-bool decode_tile_result(std::string_view bytes, TileResult& out, std::string& error, int64_t max_pixels) {
-  unsigned long long size = ZSTD_getFrameContentSize(bytes.data(), bytes.size());
-  if (size == ZSTD_CONTENTSIZE_ERROR || size == ZSTD_CONTENTSIZE_UNKNOWN) {
-    error = "tile result: not a zstd frame with a known size";
-    return false;
-  }
+namespace {
+
+// The uncompressed size of concatenated zstd frames (they decode as one: an encoder may compress
+// the parts separately), or an error if a frame is malformed, does not state its size, or the total
+// exceeds what `max_pixels` allows.
+bool decompressed_size(std::string_view bytes, unsigned long long& size, std::string& error, int64_t max_pixels) {
   const unsigned long long max_size = kHeaderBytes + 32 + (unsigned long long)max_pixels * kPixelBytes;
+  size = 0;
+  for (size_t pos = 0; pos < bytes.size();) {
+    const unsigned long long n = ZSTD_getFrameContentSize(bytes.data() + pos, bytes.size() - pos);
+    const size_t frame = ZSTD_findFrameCompressedSize(bytes.data() + pos, bytes.size() - pos);
+    if (n == ZSTD_CONTENTSIZE_ERROR || n == ZSTD_CONTENTSIZE_UNKNOWN || ZSTD_isError(frame)) {
+      error = "tile result: not zstd frames with known sizes";
+      return false;
+    }
+    size += n;
+    if (size > max_size) break;
+    pos += frame;
+  }
   if (size < kHeaderBytes + 32 || size > max_size) {
     error = "tile result: implausible size " + std::to_string(size) + " bytes";
     return false;
   }
-  std::string raw(size_t(size), '\0');
+  return true;
+}
+
+// The uncompressed bytes of a compressed result, into `raw`.
+bool decompress(std::string_view bytes, std::string& raw, std::string& error, int64_t max_pixels) {
+  unsigned long long size = 0;
+  if (!decompressed_size(bytes, size, error, max_pixels)) return false;
+  raw.resize(size_t(size));
   size_t n = ZSTD_decompress(raw.data(), raw.size(), bytes.data(), bytes.size());
   if (ZSTD_isError(n) || n != raw.size()) {
     error = std::string("tile result: corrupt or truncated: ") + (ZSTD_isError(n) ? ZSTD_getErrorName(n) : "short");
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+bool decode_tile_result(std::string_view bytes, TileResult& out, std::string& error, int64_t max_pixels) {
+  std::string decompressed;
+  const bool stored = bytes.size() >= 4 && std::memcmp(bytes.data(), kMagic, 4) == 0;
+  if (!stored && !decompress(bytes, decompressed, error, max_pixels)) return false;
+  const std::string_view raw = stored ? bytes : std::string_view(decompressed);
+  if (raw.size() < kHeaderBytes + 32) {
+    error = "tile result: implausible size " + std::to_string(raw.size()) + " bytes";
     return false;
   }
   Sha256Digest digest = sha256(raw.data(), raw.size() - 32);

@@ -187,9 +187,10 @@ std::string encode_checkpoint(uint64_t job, const JobState::Checkpoint& cp) {
   sums.pass = cp.passes - 1;
   sums.sample_end = cp.sample_end;
   sums.film = cp.sums;
-  // zstd's fast mode: a checkpoint is written for most results, by the group commit's one writer,
-  // and sums are noise in their low bits; -5 makes them 4% larger than level 1 in a third of the time.
-  return encode_tile_result(sums, /*level=*/-5);
+  // Uncompressed: a checkpoint is written for most results, by the group commit's one writer, and
+  // compressing (even zstd's fastest mode) took a third of that writer's time to save a fifth of
+  // the bytes (sums are noise in their low bits). One per tile is within the storage bound as is.
+  return encode_tile_result(sums, kUncompressed);
 }
 
 void Coordinator::Impl::checkpoint_tile(JobState& job, uint32_t tile, uint32_t min_new) {

@@ -1,7 +1,9 @@
-// The tile-result wire format: exact round trip, and every kind of damage refused.
+// The tile-result wire format: exact round trip (compressed, in concatenated frames, or stored as it
+// is), and every kind of damage refused.
 #include "tessera/farm/tile_result.h"
 
 #include <gtest/gtest.h>
+#include <zstd.h>
 
 #include <cstring>
 #include <random>
@@ -46,7 +48,7 @@ TEST(TileResult, RoundTripsEveryBit) {
   EXPECT_EQ(out.film.counters.bounce_rays, 123u);
   ASSERT_EQ(out.film.pixels().size(), in.film.pixels().size());
   EXPECT_EQ(std::memcmp(out.film.pixels().data(), in.film.pixels().data(), in.film.pixels().size() * sizeof(PixelSums)), 0);
-  std::printf("13x9 tile: %zu bytes raw, %zu compressed\n", size_t(13 * 9 * 56 + 124), bytes.size());
+  std::printf("13x9 tile: %zu bytes raw, %zu compressed\n", size_t(13 * 9 * 56 + 128), bytes.size());
 }
 
 TEST(TileResult, RefusesDamage) {
@@ -76,6 +78,57 @@ TEST(TileResult, RefusesDamage) {
   EXPECT_GT(refused, int(bytes.size()) * 99 / 100);
   std::printf("flipped bytes: %d refused, %d harmless framing\n", refused, harmless);
   // A rect larger than the limit is refused before anything is allocated for it.
+  EXPECT_FALSE(decode_tile_result(bytes, out, error, 100));
+  EXPECT_NE(error.find("implausible"), std::string::npos) << error;
+}
+
+bool same_result(const TileResult& a, const TileResult& b) {
+  return a.job_id == b.job_id && a.tile == b.tile && a.pass == b.pass && a.sample_end == b.sample_end &&
+         a.film.rect() == b.film.rect() && a.film.counters.samples == b.film.counters.samples &&
+         std::memcmp(a.film.pixels().data(), b.film.pixels().data(), a.film.pixels().size() * sizeof(PixelSums)) == 0;
+}
+
+std::string zstd_frame(std::string_view raw) {
+  std::string out(ZSTD_compressBound(raw.size()), '\0');
+  out.resize(ZSTD_compress(out.data(), out.size(), raw.data(), raw.size(), 1));
+  return out;
+}
+
+TEST(TileResult, StoredUncompressedRoundTripsAndIsChecked) {
+  const TileResult in = sample_result();
+  const std::string raw = encode_tile_result(in, kUncompressed);
+  EXPECT_EQ(raw.size(), size_t(13 * 9 * 56 + 128));
+  EXPECT_EQ(raw.substr(0, 4), "TSTR");
+  TileResult out;
+  std::string error;
+  ASSERT_TRUE(decode_tile_result(raw, out, error)) << error;
+  EXPECT_TRUE(same_result(in, out));
+  // Stored bytes are still verified: a flipped bit of the sums fails the checksum.
+  std::string bad = raw;
+  bad[200] ^= 0x01;
+  EXPECT_FALSE(decode_tile_result(bad, out, error));
+  EXPECT_NE(error.find("checksum"), std::string::npos) << error;
+  EXPECT_FALSE(decode_tile_result(raw.substr(0, raw.size() - 8), out, error));
+}
+
+TEST(TileResult, ConcatenatedFramesDecodeAsOne) {
+  const TileResult in = sample_result();
+  const std::string raw = encode_tile_result(in, kUncompressed);
+  // The raw bytes cut in three and compressed separately, as an encoder may do.
+  const std::string bytes = zstd_frame(std::string_view(raw).substr(0, 100)) +
+                            zstd_frame(std::string_view(raw).substr(100, 3000)) +
+                            zstd_frame(std::string_view(raw).substr(3100));
+  TileResult out;
+  std::string error;
+  ASSERT_TRUE(decode_tile_result(bytes, out, error)) << error;
+  EXPECT_TRUE(same_result(in, out));
+  // A missing or doubled frame is refused, and so is trailing junk after the last frame.
+  const std::string first_two = zstd_frame(std::string_view(raw).substr(0, 100)) +
+                                zstd_frame(std::string_view(raw).substr(100, 3000));
+  EXPECT_FALSE(decode_tile_result(first_two, out, error));
+  EXPECT_FALSE(decode_tile_result(bytes + zstd_frame(std::string_view(raw).substr(3100)), out, error));
+  EXPECT_FALSE(decode_tile_result(bytes + "junk", out, error));
+  // The size limit counts every frame.
   EXPECT_FALSE(decode_tile_result(bytes, out, error, 100));
   EXPECT_NE(error.find("implausible"), std::string::npos) << error;
 }

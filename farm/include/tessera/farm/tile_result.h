@@ -1,6 +1,7 @@
 // The farm's work result on the wire: the pixel sums of one tile x sample pass.
 //
-// Layout (little-endian, the whole of it zstd-compressed):
+// Layout (little-endian; the whole of it zstd-compressed, as one frame or several concatenated, or
+// stored as it is: see kUncompressed):
 //   "TSTR" magic, u32 format version,
 //   u64 job id, u32 tile index, u32 pass index, i32 x0 y0 x1 y1, u32 sample_begin, sample_end,
 //   u64 samples, camera_rays, bounce_rays, shadow_rays, nonfinite, f64 render seconds,
@@ -26,11 +27,17 @@ struct TileResult {
   FilmTile film;       // rect, sums and counters
 };
 
-/// Encodes (and compresses) a result; `level` is zstd's compression level. Pixel sums are noise in
-/// their low bits: level 1 makes them as small as level 3 does (within 0.2%) in a third of the time.
+/// The `level` that stores a result uncompressed (it starts with the magic, not a zstd frame): for
+/// bytes written locally and often (the coordinator's checkpoints), where compressing would cost
+/// more than the bytes it saves.
+inline constexpr int kUncompressed = -1000;
+
+/// Encodes (and compresses) a result; `level` is zstd's compression level, or kUncompressed. Pixel
+/// sums are noise in their low bits: level 1 makes them as small as level 3 does (within 0.2%) in a
+/// third of the time.
 std::string encode_tile_result(const TileResult& result, int level = 1);
 
-/// Decodes and verifies bytes from the network. False with `error` set on anything malformed:
+/// Decodes and verifies bytes (compressed or not). False with `error` set on anything malformed:
 /// bad compression, wrong magic or version, a size that does not match the rect, a checksum
 /// mismatch, a rect larger than `max_pixels`.
 [[nodiscard]] bool decode_tile_result(std::string_view bytes, TileResult& out, std::string& error,

@@ -16,10 +16,12 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
 struct sqlite3;
+struct sqlite3_stmt;
 
 namespace tessera::server {
 
@@ -133,9 +135,13 @@ class Store {
  private:
   using WriteLock = std::lock_guard<std::recursive_mutex>;
   void exec(const char* sql);
+  /// The write connection's statement for `sql` (a string literal: keyed by its address),
+  /// prepared once; used under write_mu_ only.
+  sqlite3_stmt* prepared(const char* sql);
   sqlite3* db_ = nullptr;  // writes
   sqlite3* rd_ = nullptr;  // reads
   std::recursive_mutex write_mu_;  // a transaction's writes are never interleaved with another's
+  std::unordered_map<const char*, sqlite3_stmt*> prepared_;
 };
 
 }  // namespace tessera::server

@@ -1,0 +1,36 @@
+// The simulated workers' tile results: bytes of a real pass's size and entropy, in the real format
+// (zstd level 1, as tessera-worker sends), made for a fraction of what compressing each would cost,
+// so the load generator measures the coordinator rather than itself.
+#pragma once
+
+#include "tessera/farm/protocol.h"
+#include "tessera/farm/tile_result.h"
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace tessera::bench {
+
+class SyntheticResults {
+ public:
+  /// The encoded result for exactly the leased unit: its own header and digest, pixel sums from one
+  /// of a few variants per tile shape and sample count, each variant compressed once. The three
+  /// parts are separate zstd frames, which decode as one.
+  std::string encode(const Lease& lease, uint64_t& rng);
+
+ private:
+  struct Variant {
+    std::vector<PixelSums> pixels;
+    std::string frame;  // the pixels' bytes, compressed
+  };
+  const Variant& variant(const Lease& lease, uint64_t& rng);
+
+  static constexpr size_t kVariants = 8;
+  std::map<std::pair<int64_t, uint32_t>, std::vector<Variant>> variants_;  // by (pixels, samples)
+  TileResult scratch_;
+};
+
+}  // namespace tessera::bench
