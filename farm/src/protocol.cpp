@@ -105,6 +105,59 @@ json to_json(const JobSettings& s) {
   return j;
 }
 
+namespace {
+
+// "12-20", "12..20", "7" or [12, 20]: an inclusive range.
+bool parse_frames(const json& j, int& first, int& last, std::string& error) {
+  try {
+    if (j.is_array() && j.size() == 2 && j[0].is_number_integer() && j[1].is_number_integer()) {
+      first = j[0].get<int>();
+      last = j[1].get<int>();
+    } else if (j.is_number_integer()) {
+      first = last = j.get<int>();
+    } else if (j.is_string()) {
+      const std::string s = j.get<std::string>();
+      size_t cut = s.find("..");
+      size_t skip = 2;
+      if (cut == std::string::npos) cut = s.find('-', 1), skip = 1;
+      size_t used = 0;
+      first = std::stoi(s.substr(0, cut), &used);
+      if (used != (cut == std::string::npos ? s.size() : cut)) throw std::invalid_argument("trailing characters");
+      last = first;
+      if (cut != std::string::npos) {
+        const std::string rest = s.substr(cut + skip);
+        last = std::stoi(rest, &used);
+        if (used != rest.size()) throw std::invalid_argument("trailing characters");
+      }
+    } else {
+      throw std::invalid_argument("type");
+    }
+  } catch (const std::exception&) {
+    error = "job settings: field 'frames' must be \"FIRST-LAST\", \"FIRST..LAST\", a frame number or [FIRST, LAST]";
+    return false;
+  }
+  if (last < first) {
+    error = "job settings: frames " + std::to_string(first) + ".." + std::to_string(last) + " ends before it starts";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+bool job_request_from_json(const json& j, JobRequest& out, std::string& error, bool require_scene) {
+  if (!j.is_object() || !j.contains("frames")) {
+    out.frames.reset();
+    return job_settings_from_json(j, out.settings, error, require_scene);
+  }
+  int first = 0, last = 0;
+  if (!parse_frames(j["frames"], first, last, error)) return false;
+  json settings = j;
+  settings.erase("frames");
+  out.frames = std::pair{first, last};
+  return job_settings_from_json(settings, out.settings, error, require_scene);
+}
+
 bool job_settings_from_json(const json& j, JobSettings& out, std::string& error, bool require_scene) {
   Fields f(j, error, "job settings");
   f.get("name", out.name);

@@ -247,8 +247,12 @@ void Coordinator::Impl::finish_job(JobState& job, bool notify) {
 }
 
 void Coordinator::Impl::send_webhook(const JobState& job) {
-  if (!job.plan().settings.webhook.empty())
-    webhooks.send(job.id(), job.plan().settings.webhook, status_json(job).dump());
+  if (job.plan().settings.webhook.empty()) return;
+  // The body is made on the sender's thread: the lease log's counts are store reads.
+  webhooks.send(job.id(), job.plan().settings.webhook, [this, status = status_of(job)]() mutable {
+    add_lease_counts(status);
+    return to_json(status).dump();
+  });
 }
 
 void Coordinator::Impl::reap_loop() {
@@ -271,18 +275,22 @@ void Coordinator::Impl::reap_loop() {
 }
 
 void Coordinator::Impl::reap_leases_and_workers() {
-  const auto now = Clock::now();
-  for (auto& [id, w] : workers)
-    if (is_live(w.state) && now - w.last_seen > dead_after()) {
-      for (auto& [lid, l] : leases) counters.expired += l.worker == id;
-      set_worker_state(id, w, WorkerState::Lost);
-    }
-  end_leases_if([&](const LeaseInfo& l) {
-    if (l.expires >= now) return false;
+  std::vector<ReapWorker> live;
+  for (auto& [id, w] : workers) live.push_back({id, is_live(w.state), w.last_seen});
+  std::vector<ReapLease> held;
+  held.reserve(leases.size());
+  for (auto& [id, l] : leases) held.push_back({id, l.worker, l.expires});
+  const Reaping reaping = decide_reaping(live, held, Clock::now(), dead_after());
+  counters.expired += reaping.leases_of_lost;
+  for (uint64_t id : reaping.lost_workers) set_worker_state(id, workers.at(id), WorkerState::Lost);
+  for (uint64_t id : reaping.expired_leases) {
+    auto it = leases.find(id);
+    if (it == leases.end()) continue;
+    const LeaseInfo& l = it->second;
     log_event(spdlog::level::warn, "lease.expired", {{"lease", l.id}, {"job", l.job}, {"unit", l.unit}, {"worker", l.worker}});
     ++counters.expired;
-    return true;
-  });
+    end_lease(it);
+  }
 }
 
 std::string Coordinator::metrics() {
@@ -335,15 +343,12 @@ std::string Coordinator::metrics() {
   return out;
 }
 
-nlohmann::json Coordinator::health() {
+Health Coordinator::health() {
   std::lock_guard<std::mutex> lock(impl_->mu);
-  size_t active = 0;
+  uint64_t active = 0;
   for (auto& [id, job] : impl_->jobs) active += !is_terminal(job->phase);
-  return {{"status", impl_->stopping ? "stopping" : "ok"},
-          {"version", impl_->fingerprint.version},
-          {"jobs_active", active},
-          {"leases", impl_->leases.size()},
-          {"uptime_seconds", std::chrono::duration<double>(Clock::now() - impl_->started).count()}};
+  return {impl_->stopping ? "stopping" : "ok", impl_->fingerprint.version, active, impl_->leases.size(),
+          std::chrono::duration<double>(Clock::now() - impl_->started).count()};
 }
 
 }  // namespace tessera::server

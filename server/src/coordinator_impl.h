@@ -8,6 +8,7 @@
 #include "job_state.h"
 #include "metrics.h"
 #include "retention.h"
+#include "reaper.h"
 #include "retention_plan.h"
 #include "scheduler.h"
 #include "webhooks.h"
@@ -156,23 +157,32 @@ struct Coordinator::Impl {
   Result<std::string> unpack_scene(const JobSettings& settings, const std::string& bundle_file);
   std::mutex unpack_mutexes_mu;
   std::map<std::string, std::weak_ptr<std::mutex>> unpack_mutexes;
-  /// Takes `mu`: stores and queues a planned job; its status.
-  Result<nlohmann::json> add_job(const std::string& name, JobPlan plan);
-  /// Under `mu`: 429 beyond --max-active-jobs queued and running jobs.
+  /// Stores (off `mu`, in a slot taken under it) and queues a planned job; its status.
+  Result<JobStatus> add_job(const std::string& name, JobPlan plan);
+  int submissions_in_flight = 0;  // slots add_job holds while it stores a job (`mu`)
+  /// Under `mu`: 429 beyond --max-active-jobs queued, running and being stored jobs.
   Status check_active_jobs() const;
-  /// Under `mu`: job status as JSON.
-  nlohmann::json status_json(const JobState& job);
+  /// Under `mu`: the job's status from memory; add_lease_counts completes it off the lock.
+  JobStatus status_of(const JobState& job) const;
+  /// The lease log's counts (store reads, so not under `mu`); left out if they cannot be read.
+  void add_lease_counts(JobStatus& status);
   /// Expires leases and marks silent workers lost, once a second.
   void reap_loop();
   /// A retention pass (retention.cpp): a snapshot under `mu`, files measured off it, the plan
-  /// (retention_plan.h, pure), rows deleted and bundles renamed away under `mu`, files removed after.
-  nlohmann::json run_retention(double now);
+  /// (retention_plan.h, pure), jobs forgotten and bundles renamed away under `mu`, then their rows
+  /// and files deleted off it. Nothing when the snapshot could not be taken.
+  std::optional<RetentionReport> run_retention(double now);
   std::optional<std::vector<RetentionJob>> retention_snapshot();
   std::map<std::string, RetentionBundle> measure_retention_files(std::vector<RetentionJob>& snapshot);
-  nlohmann::json carry_out_retention(const RetentionPlan& plan, const std::vector<RetentionJob>& snapshot,
-                                     const std::map<std::string, RetentionBundle>& bundles, double now);
-  /// Under `mu`: false when the store refused (the pass stops there).
-  bool delete_expired_job(const RetentionJob& job, double now);
+  RetentionReport carry_out_retention(const RetentionPlan& plan, const std::vector<RetentionJob>& snapshot,
+                                      const std::map<std::string, RetentionBundle>& bundles, double now);
+  /// Under `mu`: drops a finished job from memory (its rows are deleted after the lock); false if
+  /// it was retried since the snapshot.
+  bool forget_expired_job(const RetentionJob& job);
+  /// Off `mu`: the jobs' rows (leaving tombstones) and the bundles' rows deleted, pages vacuumed.
+  /// The jobs whose rows were deleted (a failure is logged; the job is found again at start-up).
+  std::vector<const RetentionJob*> delete_expired_rows(const std::vector<const RetentionJob*>& jobs,
+                                                       const std::vector<std::string>& bundles, double now);
   /// Under `mu`: renames the bundle and its folder into `trash`; false if a job uses it again.
   bool move_expired_bundle(const std::string& hash, const RetentionBundle& bundle,
                            std::vector<std::filesystem::path>& trash);

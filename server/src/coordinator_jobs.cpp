@@ -74,7 +74,7 @@ std::string read_file(const std::string& path) {
 // Checked before the scene is loaded, so a flood of submissions costs no unpacking, and again
 // before the job is stored.
 Status Coordinator::Impl::check_active_jobs() const {
-  int active = 0;
+  int active = submissions_in_flight;
   for (const auto& [id, job] : jobs) active += is_terminal(job->phase) ? 0 : 1;
   if (active < opt.max_active_jobs) return Status::success();
   return make_error(Code::TooManyRequests, "too_many_jobs",
@@ -82,7 +82,7 @@ Status Coordinator::Impl::check_active_jobs() const {
                         std::to_string(opt.max_active_jobs) + " (retry when some have finished)");
 }
 
-Result<json> Coordinator::upload_scene(const std::string& bundle) {
+Result<SceneUpload> Coordinator::upload_scene(const std::string& bundle) {
   Impl& s = *impl_;
   if (bundle.size() > s.opt.max_upload_bytes)
     return make_error(Code::PayloadTooLarge, "bundle_too_large",
@@ -99,9 +99,9 @@ Result<json> Coordinator::upload_scene(const std::string& bundle) {
   } catch (const std::exception& e) {
     return internal_error(e);
   }
-  json files = json::array();
-  for (const BundleEntry& e : inspected.files) files.push_back(e.path);
-  return json{{"hash", hash}, {"bytes", bundle.size()}, {"files", files}};
+  SceneUpload upload{hash, bundle.size(), {}};
+  for (const BundleEntry& e : inspected.files) upload.files.push_back(e.path);
+  return upload;
 }
 
 Result<std::string> Coordinator::scene_bundle_path(const std::string& hash) {
@@ -124,77 +124,36 @@ Result<std::string> Coordinator::scene_bundle(const std::string& hash) {
   }
 }
 
-namespace {
-
-// "12-20", "12..20", "7" or [12, 20]: an inclusive range, at most `max_frames` long.
-bool parse_frames(const json& j, int& first, int& last, size_t max_frames, std::string& error) {
-  try {
-    if (j.is_array() && j.size() == 2 && j[0].is_number_integer() && j[1].is_number_integer()) {
-      first = j[0].get<int>();
-      last = j[1].get<int>();
-    } else if (j.is_number_integer()) {
-      first = last = j.get<int>();
-    } else if (j.is_string()) {
-      const std::string s = j.get<std::string>();
-      size_t cut = s.find("..");
-      size_t skip = 2;
-      if (cut == std::string::npos) cut = s.find('-', 1), skip = 1;
-      size_t used = 0;
-      first = std::stoi(s.substr(0, cut), &used);
-      if (used != (cut == std::string::npos ? s.size() : cut)) throw std::invalid_argument("trailing characters");
-      last = first;
-      if (cut != std::string::npos) {
-        const std::string rest = s.substr(cut + skip);
-        last = std::stoi(rest, &used);
-        if (used != rest.size()) throw std::invalid_argument("trailing characters");
-      }
-    } else {
-      throw std::invalid_argument("type");
-    }
-  } catch (const std::exception&) {
-    error = "job settings: field 'frames' must be \"FIRST-LAST\", \"FIRST..LAST\", a frame number or [FIRST, LAST]";
-    return false;
-  }
-  if (last < first || uint64_t(int64_t(last) - first) >= max_frames) {
-    error = "job settings: frames " + std::to_string(first) + ".." + std::to_string(last) + " is not a range of 1.." +
-            std::to_string(max_frames) + " frames";
-    return false;
-  }
-  return true;
-}
-
-}  // namespace
-
-Result<json> Coordinator::submit_frames(const json& body, const std::string& bundle) {
-  Impl& s = *impl_;
-  int first = 0, last = 0;
-  std::string error;
-  if (!parse_frames(body["frames"], first, last, size_t(std::max(1, s.opt.max_active_jobs)), error))
-    return make_error(Code::BadRequest, "bad_settings", error);
-  json base = body;
-  base.erase("frames");
+Result<JobSubmission> Coordinator::submit_frames(const JobRequest& request, const std::string& bundle) {
+  const auto [first, last] = *request.frames;
+  const int64_t max_frames = std::max(1, impl_->opt.max_active_jobs);
+  if (int64_t(last) - first >= max_frames)
+    return make_error(Code::BadRequest, "bad_settings",
+                      "job settings: frames " + std::to_string(first) + ".." + std::to_string(last) +
+                          " is not a range of 1.." + std::to_string(max_frames) + " frames");
+  JobSettings base = request.settings;
   if (!bundle.empty()) {
-    Result<json> uploaded = upload_scene(bundle);
+    Result<SceneUpload> uploaded = upload_scene(bundle);
     if (!uploaded.ok()) return uploaded.status;
-    base["scene"] = uploaded.value["hash"];
+    base.scene = uploaded.value.hash;
   }
-  if (!base.contains("defines") || !base["defines"].is_object()) base["defines"] = json::object();
-  const std::string name = base.value("name", std::string("frames"));
-  json jobs = json::array();
+  const std::string name = base.name.empty() ? "frames" : base.name;
+  JobSubmission submitted{{}, std::pair{first, last}};
+  std::vector<JobStatus>& jobs = submitted.jobs;
   for (int frame = first; frame <= last; ++frame) {
-    json one = base;
-    one["defines"]["frame"] = std::to_string(frame);
-    one["name"] = name + " frame " + std::to_string(frame);
-    Result<json> r = submit_job(one, "");
+    JobSettings one = base;
+    one.defines["frame"] = std::to_string(frame);
+    one.name = name + " frame " + std::to_string(frame);
+    Result<JobStatus> r = submit_one(std::move(one), "");
     if (!r.ok()) {
-      for (const json& j : jobs) (void)cancel_job(j["id"].get<uint64_t>());
+      for (const JobStatus& j : jobs) (void)cancel_job(j.id);
       r.status.detail = "frame " + std::to_string(frame) + ": " + r.status.detail +
                         (jobs.empty() ? "" : " (the " + std::to_string(jobs.size()) + " frame(s) queued before were cancelled)");
       return r.status;
     }
     jobs.push_back(std::move(r.value));
   }
-  return json{{"jobs", jobs}, {"frames", {first, last}}};
+  return submitted;
 }
 
 // Unpacked once per bundle (later submissions list the folder); two bundles unpack in parallel.
@@ -230,13 +189,16 @@ Result<std::string> Coordinator::Impl::unpack_scene(const JobSettings& settings,
   return scene_file;
 }
 
-Result<json> Coordinator::submit_job(const json& body, const std::string& bundle) {
+Result<JobSubmission> Coordinator::submit_job(const JobRequest& request, const std::string& bundle) {
+  if (request.frames) return submit_frames(request, bundle);
+  Result<JobStatus> one = submit_one(request.settings, bundle);
+  if (!one.ok()) return one.status;
+  return JobSubmission{{std::move(one.value)}, std::nullopt};
+}
+
+Result<JobStatus> Coordinator::submit_one(JobSettings settings, const std::string& bundle) {
   Impl& s = *impl_;
-  if (body.is_object() && body.contains("frames")) return submit_frames(body, bundle);
-  JobSettings settings;
   std::string error;
-  if (!job_settings_from_json(body, settings, error, bundle.empty()))
-    return make_error(Code::BadRequest, "bad_settings", error);
   if (!settings.webhook.empty() && !s.opt.webhook_allow.empty() &&
       std::none_of(s.opt.webhook_allow.begin(), s.opt.webhook_allow.end(),
                    [&](const std::string& prefix) { return settings.webhook.rfind(prefix, 0) == 0; }))
@@ -247,9 +209,9 @@ Result<json> Coordinator::submit_job(const json& body, const std::string& bundle
     if (Status st = s.check_active_jobs(); !st.ok()) return st;
   }
   if (!bundle.empty()) {
-    Result<json> uploaded = upload_scene(bundle);
+    Result<SceneUpload> uploaded = upload_scene(bundle);
     if (!uploaded.ok()) return uploaded.status;
-    settings.scene = uploaded.value["hash"].get<std::string>();
+    settings.scene = uploaded.value.hash;
   }
   if (!check_job_limits(settings, s.opt.limits, error)) return make_error(Code::Unprocessable, "bad_settings", error);
   Result<std::string> path = scene_bundle_path(settings.scene);
@@ -265,108 +227,116 @@ Result<json> Coordinator::submit_job(const json& body, const std::string& bundle
   return s.add_job(settings.name, std::move(plan.value));
 }
 
-Result<json> Coordinator::Impl::add_job(const std::string& name, JobPlan plan) {
-  std::lock_guard<std::mutex> lock(mu);
-  if (stopping) return make_error(Code::Unavailable, "stopping", "the coordinator is shutting down");
-  if (Status st = check_active_jobs(); !st.ok()) return st;
+Result<JobStatus> Coordinator::Impl::add_job(const std::string& name, JobPlan plan) {
+  {
+    std::lock_guard<std::mutex> lock(mu);
+    if (stopping) return make_error(Code::Unavailable, "stopping", "the coordinator is shutting down");
+    if (Status st = check_active_jobs(); !st.ok()) return st;
+    ++submissions_in_flight;
+  }
+  const double now = wall_seconds();
+  const int priority = plan.settings.priority;
+  uint64_t id = 0;
+  std::unique_ptr<JobState> job;
   try {
-    const double now = wall_seconds();
-    const int priority = plan.settings.priority;
-    uint64_t id = store.add_job(name, to_json(plan).dump(), priority, now);
-    auto job = std::make_unique<JobState>(id, std::move(plan), name, priority, now);
-    log_event(spdlog::level::info, "job.submitted",
-              {{"job", id}, {"name", name}, {"width", job->plan().window.width()},
-               {"height", job->plan().window.height()}, {"spp", job->plan().settings.spp}, {"tiles", job->num_tiles()},
-               {"passes", job->num_passes()}, {"scene", job->plan().settings.scene}});
-    json status = status_json(*job);
-    jobs.emplace(id, std::move(job));
-    work_cv.notify_all();
-    return status;
+    id = store.add_job(name, to_json(plan).dump(), priority, now);
+    job = std::make_unique<JobState>(id, std::move(plan), name, priority, now);
   } catch (const std::exception& e) {
+    std::lock_guard<std::mutex> lock(mu);
+    --submissions_in_flight;
     return internal_error(e);
   }
+  log_event(spdlog::level::info, "job.submitted",
+            {{"job", id}, {"name", name}, {"width", job->plan().window.width()},
+             {"height", job->plan().window.height()}, {"spp", job->plan().settings.spp}, {"tiles", job->num_tiles()},
+             {"passes", job->num_passes()}, {"scene", job->plan().settings.scene}});
+  JobStatus status;
+  {
+    // Stored, so accepted (even if the coordinator began stopping meanwhile: it runs after a restart).
+    std::lock_guard<std::mutex> lock(mu);
+    --submissions_in_flight;
+    status = status_of(*job);
+    jobs.emplace(id, std::move(job));
+    work_cv.notify_all();
+  }
+  add_lease_counts(status);
+  return status;
 }
 
-json Coordinator::Impl::status_json(const JobState& job) {
-  const double now = wall_seconds();
-  const double end = job.finished > 0 ? job.finished : now;
-  const double elapsed = job.started > 0 ? end - job.started : 0;
-  const double fraction = job.total_samples() ? double(job.done_samples()) / double(job.total_samples()) : 1.0;
-  json workers_json = json::array();
+JobStatus Coordinator::Impl::status_of(const JobState& job) const {
+  JobStatus s;
+  const JobPlan& p = job.plan();
+  s.id = job.id();
+  s.name = job.name();
+  s.state = phase_name(job.phase);
+  s.priority = job.priority();
+  s.error = job.error;
+  s.settings = p.settings;
+  s.scene_file = p.scene_file;
+  s.width = p.window.width();
+  s.height = p.window.height();
+  s.spp = p.settings.spp;
+  s.tiles = job.num_tiles();
+  s.passes = job.num_passes();
+  s.units_done = job.done_units();
+  s.units_total = job.planned_units();
+  s.samples_done = job.done_samples();
+  s.samples_total = job.total_samples();
+  s.progress = s.samples_total ? double(s.samples_done) / double(s.samples_total) : 1.0;
+  const double end = job.finished > 0 ? job.finished : wall_seconds();
+  s.elapsed_seconds = job.started > 0 ? end - job.started : 0;
+  s.eta_seconds = s.progress > 0 && s.progress < 1 ? s.elapsed_seconds * (1 - s.progress) / s.progress : 0.0;
+  s.created = job.created();
   for (auto& [wid, samples] : job.samples_by_worker()) {
     auto w = workers.find(wid);
-    workers_json.push_back({{"id", wid},
-                            {"name", w != workers.end() ? w->second.row.name : ""},
-                            {"samples", samples},
-                            {"share", job.done_samples() ? double(samples) / double(job.done_samples()) : 0}});
+    s.workers.push_back({wid, w != workers.end() ? w->second.row.name : "", samples,
+                         s.samples_done ? double(samples) / double(s.samples_done) : 0});
   }
-  const JobPlan& p = job.plan();
-  json j = {{"id", job.id()},
-            {"name", job.name()},
-            {"state", phase_name(job.phase)},
-            {"priority", job.priority()},
-            {"error", job.error},
-            {"settings", to_json(p.settings)},
-            {"scene_file", p.scene_file},
-            {"width", p.window.width()},
-            {"height", p.window.height()},
-            {"spp", p.settings.spp},
-            {"tiles", job.num_tiles()},
-            {"passes", job.num_passes()},
-            {"units_done", job.done_units()},
-            {"units_total", job.planned_units()},
-            {"samples_done", job.done_samples()},
-            {"samples_total", job.total_samples()},
-            {"progress", fraction},
-            {"elapsed_seconds", elapsed},
-            {"eta_seconds", fraction > 0 && fraction < 1 ? elapsed * (1 - fraction) / fraction : 0.0},
-            {"created", job.created()},
-            {"workers", workers_json},
-            {"duplicate_results", job.duplicates},
-            {"mismatched_results", job.mismatched},
-            {"result_bytes", job.result_bytes},
-            {"lease_bytes", job.lease_bytes},
-            {"nonfinite_samples", job.counters().nonfinite}};
+  s.duplicate_results = job.duplicates;
+  s.mismatched_results = job.mismatched;
+  s.result_bytes = job.result_bytes;
+  s.lease_bytes = job.lease_bytes;
+  s.nonfinite_samples = job.counters().nonfinite;
   // Speed and noise: samples/s over the job's running time, and the estimated relMSE of the image
-  // now (noise_estimate.h; null until every pixel has two samples).
-  j["samples_per_second"] = elapsed > 0 ? double(job.done_samples()) / elapsed : 0.0;
-  const NoiseEstimate noise = job.noise();
-  j["noise_estimate"] = std::isfinite(noise.rel_mse) ? json(noise.rel_mse) : json(nullptr);
-  j["target_error"] = p.settings.target_error;
-  j["spp_done"] = job.spp_complete();
-  j["stopped_at_target"] = job.converged();
+  // now (noise_estimate.h).
+  s.samples_per_second = s.elapsed_seconds > 0 ? double(s.samples_done) / s.elapsed_seconds : 0.0;
+  if (const NoiseEstimate noise = job.noise(); std::isfinite(noise.rel_mse)) s.noise_estimate = noise.rel_mse;
+  s.target_error = p.settings.target_error;
+  s.spp_done = job.spp_complete();
+  s.stopped_at_target = job.converged();
+  return s;
+}
+
+void Coordinator::Impl::add_lease_counts(JobStatus& status) {
   try {
-    j["leases_issued"] = store.leases_issued(job.id());
-    j["reissued_acknowledged_passes"] = store.reissued_after_ack(job.id());
+    status.leases_issued = store.leases_issued(status.id);
+    status.reissued_acknowledged_passes = store.reissued_after_ack(status.id);
   } catch (const std::exception&) {
   }
-  return j;
 }
 
-Result<json> Coordinator::job_status(uint64_t id) {
-  std::lock_guard<std::mutex> lock(impl_->mu);
-  auto it = impl_->jobs.find(id);
-  if (it == impl_->jobs.end()) return impl_->missing_job(id);
-  return impl_->status_json(*it->second);
+Result<JobStatus> Coordinator::job_status(uint64_t id) {
+  JobStatus status;
+  {
+    std::lock_guard<std::mutex> lock(impl_->mu);
+    auto it = impl_->jobs.find(id);
+    if (it == impl_->jobs.end()) return impl_->missing_job(id);
+    status = impl_->status_of(*it->second);
+  }
+  impl_->add_lease_counts(status);
+  return status;
 }
 
-Result<json> Coordinator::list_jobs() {
+Result<std::vector<JobSummary>> Coordinator::list_jobs() {
   std::lock_guard<std::mutex> lock(impl_->mu);
-  json list = json::array();
-  // A summary per job, straight from memory (status_json also queries the lease log).
+  std::vector<JobSummary> list;
   for (auto& [id, job] : impl_->jobs) {
     const JobPlan& p = job->plan();
-    list.push_back({{"id", id},
-                    {"name", job->name()},
-                    {"state", phase_name(job->phase)},
-                    {"priority", job->priority()},
-                    {"progress", job->total_samples() ? double(job->done_samples()) / double(job->total_samples()) : 1.0},
-                    {"width", p.window.width()},
-                    {"height", p.window.height()},
-                    {"spp", p.settings.spp},
-                    {"error", job->error}});
+    list.push_back({id, job->name(), phase_name(job->phase), job->error, job->priority(),
+                    job->total_samples() ? double(job->done_samples()) / double(job->total_samples()) : 1.0,
+                    p.window.width(), p.window.height(), p.settings.spp});
   }
-  return json{{"jobs", list}};
+  return list;
 }
 
 Result<ImageBytes> Coordinator::job_image(uint64_t id, const std::string& format) {

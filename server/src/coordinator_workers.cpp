@@ -416,20 +416,14 @@ Status Coordinator::drain_worker(uint64_t worker) {
   return Status::success();
 }
 
-Result<json> Coordinator::list_workers() {
+Result<std::vector<WorkerStatus>> Coordinator::list_workers() {
   Impl& s = *impl_;
   std::lock_guard<std::mutex> lock(s.mu);
-  json list = json::array();
-  for (auto& [id, w] : s.workers) {
-    list.push_back({{"id", id},
-                    {"name", w.row.name},
-                    {"threads", w.row.threads},
-                    {"state", worker_state_name(w.state)},
-                    {"units_done", w.units_done},
-                    {"samples_done", w.samples_done},
-                    {"samples_per_second", w.render_seconds > 0 ? double(w.samples_done) / w.render_seconds : 0.0}});
-  }
-  return json{{"workers", list}};
+  std::vector<WorkerStatus> list;
+  for (auto& [id, w] : s.workers)
+    list.push_back({id, w.row.name, worker_state_name(w.state), int(w.row.threads), w.units_done, w.samples_done,
+                    w.render_seconds > 0 ? double(w.samples_done) / w.render_seconds : 0.0});
+  return list;
 }
 
 }  // namespace tessera::server

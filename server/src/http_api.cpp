@@ -97,17 +97,20 @@ void normalise_body_headers(httplib::Request& req) {
   }
 }
 
-// A service's answer as JSON: the protocol types' to_json (farm/protocol.h), or JSON already.
-const json& as_json(const json& j) { return j; }
-template <class T>
-json as_json(const T& value) {
-  return to_json(value);
-}
-
+// A service's answer as JSON: the farm's types' to_json (farm/protocol.h, job_status.h, farm_status.h).
 template <class T>
 void send(httplib::Response& res, const Result<T>& r, int ok_status = 200) {
   if (!r.ok()) return send_error(res, r.status);
-  send_json(res, ok_status, as_json(r.value));
+  send_json(res, ok_status, to_json(r.value));
+}
+
+// A list answered as {"<key>": [...]}.
+template <class T>
+void send_list(httplib::Response& res, const char* key, const Result<std::vector<T>>& r) {
+  if (!r.ok()) return send_error(res, r.status);
+  json list = json::array();
+  for (const T& item : r.value) list.push_back(to_json(item));
+  send_json(res, 200, json{{key, list}});
 }
 
 void send(httplib::Response& res, const Status& s, int ok_status = 200) {
@@ -179,7 +182,7 @@ void install_routes(httplib::Server& http, Coordinator& c, uint64_t max_upload_b
     return httplib::Server::HandlerResponse::Unhandled;
   });
 
-  http.Get("/healthz", [&c](const httplib::Request&, httplib::Response& res) { send_json(res, 200, c.health()); });
+  http.Get("/healthz", [&c](const httplib::Request&, httplib::Response& res) { send_json(res, 200, to_json(c.health())); });
   install_dashboard(http);
 
   http.Get("/metrics", [&c](const httplib::Request&, httplib::Response& res) {
@@ -210,9 +213,13 @@ void install_routes(httplib::Server& http, Coordinator& c, uint64_t max_upload_b
     } else if (!parse_body(req, res, settings)) {
       return;
     }
-    send(res, c.submit_job(settings, bundle), 201);
+    JobRequest request;
+    std::string error;
+    if (!job_request_from_json(settings, request, error, /*require_scene=*/bundle.empty()))
+      return send_error(res, make_error(Code::BadRequest, "bad_settings", error));
+    send(res, c.submit_job(request, bundle), 201);
   });
-  http.Get("/api/v1/jobs", [&c](const httplib::Request&, httplib::Response& res) { send(res, c.list_jobs()); });
+  http.Get("/api/v1/jobs", [&c](const httplib::Request&, httplib::Response& res) { send_list(res, "jobs", c.list_jobs()); });
   http.Get(R"(/api/v1/jobs/(\d+))", [&c](const httplib::Request& req, httplib::Response& res) {
     uint64_t id;
     if (parse_id(req, 1, id, res)) send(res, c.job_status(id));
@@ -255,7 +262,9 @@ void install_routes(httplib::Server& http, Coordinator& c, uint64_t max_upload_b
       return send_error(res, make_error(Code::BadRequest, "bad_registration", error));
     send(res, c.register_worker(hello), 201);
   });
-  http.Get("/api/v1/workers", [&c](const httplib::Request&, httplib::Response& res) { send(res, c.list_workers()); });
+  http.Get("/api/v1/workers", [&c](const httplib::Request&, httplib::Response& res) {
+    send_list(res, "workers", c.list_workers());
+  });
   http.Post(R"(/api/v1/workers/(\d+)/lease)", [&c](const httplib::Request& req, httplib::Response& res) {
     uint64_t id;
     if (!parse_id(req, 1, id, res)) return;

@@ -17,7 +17,6 @@
 namespace tessera::server {
 
 namespace fs = std::filesystem;
-using nlohmann::json;
 
 namespace {
 
@@ -113,9 +112,9 @@ std::map<std::string, RetentionBundle> Coordinator::Impl::measure_retention_file
   return bundles;
 }
 
-json Coordinator::Impl::run_retention(double now) {
+std::optional<RetentionReport> Coordinator::Impl::run_retention(double now) {
   std::optional<std::vector<RetentionJob>> snapshot = retention_snapshot();
-  if (!snapshot) return json{{"error", "cannot measure stored results"}};
+  if (!snapshot) return std::nullopt;
   const std::map<std::string, RetentionBundle> bundles = measure_retention_files(*snapshot);  // (off the lock)
   const RetentionPlan plan =
       plan_retention(*snapshot, bundles, {opt.retain_days * 86400.0, opt.retain_bytes, kBundleGraceSeconds}, now);
@@ -125,60 +124,73 @@ json Coordinator::Impl::run_retention(double now) {
   return carry_out_retention(plan, *snapshot, bundles, now);
 }
 
-json Coordinator::Impl::carry_out_retention(const RetentionPlan& plan, const std::vector<RetentionJob>& snapshot,
-                                            const std::map<std::string, RetentionBundle>& bundles, double now) {
+RetentionReport Coordinator::Impl::carry_out_retention(const RetentionPlan& plan, const std::vector<RetentionJob>& snapshot,
+                                                       const std::map<std::string, RetentionBundle>& bundles, double now) {
   std::vector<fs::path> trash;  // removed after the lock: images, renamed bundles and scene folders
-  uint64_t deleted_jobs = 0, deleted_bundles = 0, freed = 0;
+  std::vector<const RetentionJob*> forgotten;
+  std::vector<std::string> moved;
   {
     std::lock_guard<std::mutex> lock(mu);
     std::map<uint64_t, const RetentionJob*> by_id;
     for (const RetentionJob& j : snapshot) by_id[j.id] = &j;
-    for (uint64_t id : plan.jobs) {
-      const RetentionJob& j = *by_id.at(id);
-      if (!delete_expired_job(j, now)) break;
-      trash.push_back(image_path(id));
-      ++deleted_jobs;
-      freed += j.bytes;
-    }
+    for (uint64_t id : plan.jobs)
+      if (forget_expired_job(*by_id.at(id))) forgotten.push_back(by_id.at(id));
     for (const std::string& hash : plan.bundles)
-      if (move_expired_bundle(hash, bundles.at(hash), trash)) {
-        ++deleted_bundles;
-        freed += bundles.at(hash).bytes;
-      }
-    if (deleted_jobs > 0) try {
-        store.incremental_vacuum();
-      } catch (const std::exception& e) {
-        spdlog::warn("retention: incremental vacuum failed: {}", e.what());
-      }
-    retention.deleted_jobs += deleted_jobs;
-    retention.deleted_bundles += deleted_bundles;
-    retention.freed_bytes += freed;
-    retention.data_bytes = plan.total >= freed ? plan.total - freed : 0;
-    ++retention.passes;
+      if (move_expired_bundle(hash, bundles.at(hash), trash)) moved.push_back(hash);
   }
+  RetentionReport report;
+  for (const RetentionJob* j : delete_expired_rows(forgotten, moved, now)) {
+    trash.push_back(image_path(j->id));
+    ++report.deleted_jobs;
+    report.freed_bytes += j->bytes;
+  }
+  for (const std::string& hash : moved) report.freed_bytes += bundles.at(hash).bytes;
+  report.deleted_bundles = moved.size();
+  report.data_bytes = plan.total >= report.freed_bytes ? plan.total - report.freed_bytes : 0;
   std::error_code ec;
   for (const fs::path& p : trash) fs::remove_all(p, ec);
-  return json{{"deleted_jobs", deleted_jobs}, {"deleted_bundles", deleted_bundles}, {"freed_bytes", freed},
-              {"data_bytes", plan.total >= freed ? plan.total - freed : 0}};
+  std::lock_guard<std::mutex> lock(mu);
+  retention.deleted_jobs += report.deleted_jobs;
+  retention.deleted_bundles += report.deleted_bundles;
+  retention.freed_bytes += report.freed_bytes;
+  retention.data_bytes = report.data_bytes;
+  ++retention.passes;
+  return report;
 }
 
-bool Coordinator::Impl::delete_expired_job(const RetentionJob& j, double now) {
+bool Coordinator::Impl::forget_expired_job(const RetentionJob& j) {
   auto it = jobs.find(j.id);
   // Retried (queued again) since the snapshot: not finished any more.
   if (it == jobs.end() || !is_terminal(it->second->phase) ||
       (it->second->finished > 0 ? it->second->finished : it->second->created()) != j.ended)
-    return true;
-  try {
-    store.delete_job(j.id, now);
-  } catch (const std::exception& e) {
-    spdlog::warn("retention: cannot delete job {}: {}", j.id, e.what());
     return false;
-  }
   end_leases_if([&](const LeaseInfo& l) { return l.job == j.id; });
   jobs.erase(it);
   retention.finished_result_bytes.erase(j.id);
-  log_event(spdlog::level::info, "job.expired", {{"job", j.id}, {"bytes", j.bytes}});
   return true;
+}
+
+std::vector<const RetentionJob*> Coordinator::Impl::delete_expired_rows(const std::vector<const RetentionJob*>& jobs,
+                                                                        const std::vector<std::string>& bundles,
+                                                                        double now) {
+  std::vector<const RetentionJob*> deleted;
+  for (const RetentionJob* j : jobs) try {
+      store.delete_job(j->id, now);
+      deleted.push_back(j);
+      log_event(spdlog::level::info, "job.expired", {{"job", j->id}, {"bytes", j->bytes}});
+    } catch (const std::exception& e) {
+      spdlog::warn("retention: cannot delete job {}: {} (it is back after a restart)", j->id, e.what());
+    }
+  for (const std::string& hash : bundles) try {
+      store.delete_scene(hash);
+    } catch (const std::exception&) {
+    }
+  if (!deleted.empty()) try {
+      store.incremental_vacuum();
+    } catch (const std::exception& e) {
+      spdlog::warn("retention: incremental vacuum failed: {}", e.what());
+    }
+  return deleted;
 }
 
 bool Coordinator::Impl::move_expired_bundle(const std::string& hash, const RetentionBundle& b, std::vector<fs::path>& trash) {
@@ -196,18 +208,14 @@ bool Coordinator::Impl::move_expired_bundle(const std::string& hash, const Reten
     fs::rename(p, to, ec);
     if (!ec) trash.push_back(to);
   }
-  try {
-    store.delete_scene(hash);
-  } catch (const std::exception&) {
-  }
   log_event(spdlog::level::info, "bundle.expired", {{"scene", hash}, {"bytes", b.bytes}});
   return true;
 }
 
-Result<json> Coordinator::apply_retention(double now) {
-  json report = impl_->run_retention(now > 0 ? now : wall_seconds());
-  if (report.contains("error")) return make_error(Code::Internal, "retention_failed", report["error"].get<std::string>());
-  return report;
+Result<RetentionReport> Coordinator::apply_retention(double now) {
+  std::optional<RetentionReport> report = impl_->run_retention(now > 0 ? now : wall_seconds());
+  if (!report) return make_error(Code::Internal, "retention_failed", "cannot measure stored results");
+  return *report;
 }
 
 std::string retention_metrics(const RetentionState& r) {

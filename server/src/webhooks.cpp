@@ -5,6 +5,7 @@
 #include <httplib.h>
 
 #include <chrono>
+#include <utility>
 
 namespace tessera::server {
 
@@ -19,14 +20,14 @@ WebhookSender::~WebhookSender() {
   thread_.join();
 }
 
-void WebhookSender::send(uint64_t job, std::string url, std::string body) {
+void WebhookSender::send(uint64_t job, std::string url, std::function<std::string()> body) {
   {
     std::lock_guard<std::mutex> lock(mu_);
     if (queue_.size() >= 10000) {  // a dead endpoint must not grow memory without bound
       ++failed_;
       return;
     }
-    queue_.push_back({job, std::move(url), std::move(body)});
+    queue_.push_back({job, std::move(url), std::move(body), {}});
   }
   cv_.notify_all();
 }
@@ -84,7 +85,13 @@ void WebhookSender::loop() {
     lock.unlock();
     std::string error;
     bool ok = false;
-    for (int attempt = 0; attempt < 3 && !ok; ++attempt) {
+    try {
+      call.body = std::exchange(call.make_body, nullptr)();
+    } catch (const std::exception& e) {
+      error = e.what();
+      call.body.clear();
+    }
+    for (int attempt = 0; attempt < 3 && !ok && !call.body.empty(); ++attempt) {
       if (attempt > 0) {
         std::unique_lock<std::mutex> wait_lock(mu_);
         if (cv_.wait_for(wait_lock, std::chrono::seconds(attempt == 1 ? 1 : 4), [this] { return stop_; })) break;

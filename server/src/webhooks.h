@@ -8,6 +8,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -21,7 +22,8 @@ class WebhookSender {
   WebhookSender(const WebhookSender&) = delete;
   WebhookSender& operator=(const WebhookSender&) = delete;
 
-  void send(uint64_t job, std::string url, std::string body);
+  /// `body` is called on the sender's thread, once, before the first attempt.
+  void send(uint64_t job, std::string url, std::function<std::string()> body);
 
   uint64_t delivered() const;
   uint64_t failed() const;
@@ -29,7 +31,9 @@ class WebhookSender {
  private:
   struct Call {
     uint64_t job;
-    std::string url, body;
+    std::string url;
+    std::function<std::string()> make_body;
+    std::string body;
   };
   void loop();
   bool post(const Call& call, std::string& error) const;

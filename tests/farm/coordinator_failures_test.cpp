@@ -24,9 +24,8 @@ server::CoordinatorOptions fast(const TempDir& dir, bool speculate, double inter
 void sleep_seconds(double s) { std::this_thread::sleep_for(std::chrono::duration<double>(s)); }
 
 std::string worker_state(Coordinator& c, uint64_t id) {
-  const json workers = c.list_workers().value;
-  for (const json& w : workers["workers"])
-    if (w["id"] == id) return w["state"];
+  for (const WorkerStatus& w : c.list_workers().value)
+    if (w.id == id) return w.state;
   return "";
 }
 
@@ -40,7 +39,7 @@ TEST(CoordinatorFailures, ASilentWorkerIsDeclaredDeadAndItsLeaseReissuedAtOnce) 
   TempDir dir;
   Coordinator c(fast(dir, /*speculate=*/false));
   const uint64_t a = add_worker(c, "a"), b = add_worker(c, "b");
-  ASSERT_TRUE(c.submit_job(json{{"tile_size", 8}}, bundle()).ok());
+  ASSERT_TRUE(submit(c, json{{"tile_size", 8}}, bundle()).ok());
   nlohmann::json first = lease_json(c.lease(a, 0));
   ASSERT_TRUE(first.is_object());
   EXPECT_EQ(worker_state(c, a), "busy");
@@ -74,7 +73,7 @@ TEST(CoordinatorFailures, AfterARestartLeasesInFlightWaitForTheirWorkers) {
     Coordinator c(fast(dir, false, 1.0));
     w = add_worker(c, "w");
     v = add_worker(c, "v");
-    id = c.submit_job(json{{"tile_size", 8}, {"seed", 1}}, bundle()).value["id"];
+    id = submit(c, json{{"tile_size", 8}, {"seed", 1}}, bundle()).value.jobs.at(0).id;
     held = lease_json(c.lease(w, 0));  // then the coordinator "dies" with this lease in flight
     ASSERT_TRUE(held.is_object());
   }
@@ -82,7 +81,7 @@ TEST(CoordinatorFailures, AfterARestartLeasesInFlightWaitForTheirWorkers) {
   // Another worker takes everything else, but not the held unit.
   while (deliver_one(c, v, tiny.scene(), 1)) {
   }
-  json st = c.job_status(id).value;
+  json st = to_json(c.job_status(id).value);
   EXPECT_EQ(st["units_done"].get<int>() + 1, st["units_total"].get<int>());
   // Its worker reports it and delivers it: nothing was rendered twice.
   HeldLease h{held["id"].get<uint64_t>(), held["job"].get<uint64_t>(), held["tile"].get<uint32_t>(),
@@ -90,7 +89,7 @@ TEST(CoordinatorFailures, AfterARestartLeasesInFlightWaitForTheirWorkers) {
   json hb = {{"drop", c.heartbeat(w, {h}).value}};
   EXPECT_TRUE(hb["drop"].empty()) << hb.dump();
   ASSERT_TRUE(c.upload_result(w, held["id"], render_unit(held, tiny.scene(), 1)).ok());
-  st = c.job_status(id).value;
+  st = to_json(c.job_status(id).value);
   EXPECT_EQ(st["state"], "done");
   EXPECT_EQ(st["leases_issued"], st["units_total"]) << "a unit was leased twice";
   EXPECT_EQ(st["duplicate_results"], 0);
@@ -104,7 +103,7 @@ TEST(CoordinatorFailures, AHeldLeaseNobodyClaimsIsReissuedAfterTheBound) {
     Coordinator c(fast(dir, false));
     const uint64_t w = add_worker(c, "w");
     v = add_worker(c, "v");
-    ASSERT_TRUE(c.submit_job(json{{"tile_size", 64}, {"spp", 1}}, bundle()).ok());  // one unit
+    ASSERT_TRUE(submit(c, json{{"tile_size", 64}, {"spp", 1}}, bundle()).ok());  // one unit
     held = lease_json(c.lease(w, 0));
     ASSERT_TRUE(held.is_object());
   }
@@ -120,7 +119,7 @@ TEST(CoordinatorFailures, IdleWorkersGetOneCopyOfTheLastUnitAndTheFirstResultWin
   TinyScene tiny;
   Coordinator c(fast(dir, /*speculate=*/true));
   const uint64_t a = add_worker(c, "a"), b = add_worker(c, "b"), d = add_worker(c, "d");
-  const uint64_t id = c.submit_job(json{{"tile_size", 64}, {"spp", 1}, {"seed", 5}}, bundle()).value["id"];
+  const uint64_t id = submit(c, json{{"tile_size", 64}, {"spp", 1}, {"seed", 5}}, bundle()).value.jobs.at(0).id;
   nlohmann::json la = lease_json(c.lease(a, 0));
   ASSERT_TRUE(la.is_object());
   EXPECT_TRUE(!c.lease(a, 0).value) << "never a copy of its own lease";
@@ -131,11 +130,11 @@ TEST(CoordinatorFailures, IdleWorkersGetOneCopyOfTheLastUnitAndTheFirstResultWin
   EXPECT_NE(lb["id"], la["id"]);
   EXPECT_TRUE(!c.lease(d, 0).value) << "at most one extra copy";
   ASSERT_TRUE(c.upload_result(b, lb["id"], render_unit(lb, tiny.scene(), 5)).value.accepted);
-  EXPECT_EQ(c.job_status(id).value["state"], "done");
+  EXPECT_EQ(c.job_status(id).value.state, "done");
   auto late = c.upload_result(a, la["id"], render_unit(la, tiny.scene(), 5));
   ASSERT_TRUE(late.ok());
   EXPECT_TRUE(late.value.duplicate);
-  json st = c.job_status(id).value;
+  json st = to_json(c.job_status(id).value);
   EXPECT_EQ(st["duplicate_results"], 1);
   EXPECT_EQ(st["mismatched_results"], 0) << "the same unit renders the same bits";
   EXPECT_NE(c.metrics().find("tessera_passes_total{event=\"speculative\"} 1"), std::string::npos);
@@ -146,7 +145,7 @@ TEST(CoordinatorFailures, AResultCarriesTheNextLeaseAndItsRetryIsAnsweredAsTheFi
   TinyScene tiny;
   Coordinator c(fast(dir, /*speculate=*/false));
   const uint64_t a = add_worker(c, "a"), b = add_worker(c, "b");
-  const uint64_t id = c.submit_job(json{{"tile_size", 8}, {"spp", 1}, {"seed", 5}}, bundle()).value["id"];
+  const uint64_t id = submit(c, json{{"tile_size", 8}, {"spp", 1}, {"seed", 5}}, bundle()).value.jobs.at(0).id;
   nlohmann::json first = lease_json(c.lease(a, 0));
   ASSERT_TRUE(first.is_object());
   const std::string bytes = render_unit(first, tiny.scene(), 5);
@@ -160,10 +159,10 @@ TEST(CoordinatorFailures, AResultCarriesTheNextLeaseAndItsRetryIsAnsweredAsTheFi
   json retry = to_json(c.upload_result(a, first["id"], bytes).value);
   EXPECT_TRUE(retry["accepted"].get<bool>());
   EXPECT_FALSE(retry["duplicate"].get<bool>());
-  EXPECT_EQ(c.job_status(id).value["duplicate_results"], 0);
+  EXPECT_EQ(c.job_status(id).value.duplicate_results, 0);
   // Another worker's copy of the same unit is a duplicate.
   EXPECT_TRUE(c.upload_result(b, 0, bytes).value.duplicate);
-  EXPECT_EQ(c.job_status(id).value["duplicate_results"], 1);
+  EXPECT_EQ(c.job_status(id).value.duplicate_results, 1);
 }
 
 TEST(CoordinatorFailures, ALaterResultThatDiffersIsCountedAsAMismatch) {
@@ -171,13 +170,13 @@ TEST(CoordinatorFailures, ALaterResultThatDiffersIsCountedAsAMismatch) {
   TinyScene tiny;
   Coordinator c(fast(dir, true));
   const uint64_t a = add_worker(c, "a"), b = add_worker(c, "b");
-  const uint64_t id = c.submit_job(json{{"tile_size", 64}, {"spp", 1}, {"seed", 5}}, bundle()).value["id"];
+  const uint64_t id = submit(c, json{{"tile_size", 64}, {"spp", 1}, {"seed", 5}}, bundle()).value.jobs.at(0).id;
   json la = lease_json(c.lease(a, 0)), lb = lease_json(c.lease(b, 0));
   ASSERT_TRUE(la.is_object() && lb.is_object());
   ASSERT_TRUE(c.upload_result(a, la["id"], render_unit(la, tiny.scene(), 5)).ok());
   // A broken worker: another seed gives other sums for the same unit.
   ASSERT_TRUE(c.upload_result(b, lb["id"], render_unit(lb, tiny.scene(), 6)).ok());
-  json st = c.job_status(id).value;
+  json st = to_json(c.job_status(id).value);
   EXPECT_EQ(st["duplicate_results"], 1);
   EXPECT_EQ(st["mismatched_results"], 1);
   EXPECT_NE(c.metrics().find("tessera_passes_total{event=\"mismatched\"} 1"), std::string::npos);
@@ -186,7 +185,7 @@ TEST(CoordinatorFailures, ALaterResultThatDiffersIsCountedAsAMismatch) {
 TEST(CoordinatorFailures, AnEndedJobKeepsItsPriority) {
   TempDir dir;
   Coordinator c(options(dir));
-  const uint64_t id = c.submit_job(json{{"tile_size", 8}}, bundle()).value["id"];
+  const uint64_t id = submit(c, json{{"tile_size", 8}}, bundle()).value.jobs.at(0).id;
   ASSERT_TRUE(c.cancel_job(id).ok());
   EXPECT_EQ(c.set_priority(id, 3).code, server::Code::Conflict);
 }

@@ -42,6 +42,16 @@ inline nlohmann::json lease_json(const server::Result<std::optional<Lease>>& r) 
   return r.value ? to_json(*r.value) : nlohmann::json();
 }
 
+/// Submits `settings` as a client sends them (JSON) with `bundle`, parsed as the HTTP layer does.
+inline server::Result<JobSubmission> submit(server::Coordinator& c, const nlohmann::json& settings,
+                                            const std::string& bundle) {
+  JobRequest request;
+  std::string error;
+  if (!job_request_from_json(settings, request, error, bundle.empty()))
+    return server::make_error(server::Code::BadRequest, "bad_settings", error);
+  return c.submit_job(request, bundle);
+}
+
 inline server::CoordinatorOptions options(const TempDir& dir) {
   server::CoordinatorOptions o;
   o.data_dir = (dir.path / "data").string();

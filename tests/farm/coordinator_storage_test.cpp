@@ -82,9 +82,9 @@ TEST(CoordinatorStorage, AThousandUnitJobKeepsCheckpointsAndSmallRowsNotItsResul
   uint64_t result_bytes = 0;
   {
     Coordinator c(options(straight));
-    const uint64_t id = c.submit_job(kJob, bundle()).value["id"];
+    const uint64_t id = submit(c, kJob, bundle()).value.jobs.at(0).id;
     EXPECT_EQ(deliver(c, 1, 1000), 1000);
-    const json st = c.job_status(id).value;
+    const json st = to_json(c.job_status(id).value);
     ASSERT_EQ(st["state"], "done");
     result_bytes = st["result_bytes"];
     reference = image(c, id);
@@ -102,17 +102,17 @@ TEST(CoordinatorStorage, AThousandUnitJobKeepsCheckpointsAndSmallRowsNotItsResul
   {
     Coordinator c(options(interrupted));
     const uint64_t w = add_worker(c, "w");
-    id = c.submit_job(kJob, bundle()).value["id"];
+    id = submit(c, kJob, bundle()).value.jobs.at(0).id;
     EXPECT_EQ(deliver(c, w, 350), 350);
   }
   Coordinator c(options(interrupted));
-  EXPECT_EQ(c.job_status(id).value["units_done"], 350);
+  EXPECT_EQ(c.job_status(id).value.units_done, 350);
   EXPECT_EQ(deliver(c, 1, 350), 350);
   ASSERT_TRUE(c.cancel_job(id).ok());
   ASSERT_TRUE(c.retry_job(id).ok());
-  EXPECT_EQ(c.job_status(id).value["units_done"], 700);
+  EXPECT_EQ(c.job_status(id).value.units_done, 700);
   EXPECT_EQ(deliver(c, 1, 1000), 300);
-  ASSERT_EQ(c.job_status(id).value["state"], "done");
+  ASSERT_EQ(c.job_status(id).value.state, "done");
   EXPECT_EQ(image(c, id), reference);
 }
 

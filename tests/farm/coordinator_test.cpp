@@ -12,9 +12,9 @@ TEST(Coordinator, FailingWorkersAreKeptOffAndThenTheJobFails) {
   TempDir dir;
   Coordinator c(options(dir));
   const uint64_t a = add_worker(c, "a"), b = add_worker(c, "b"), d = add_worker(c, "d");
-  auto job = c.submit_job(json{{"tile_size", 8}}, bundle());
+  auto job = submit(c, json{{"tile_size", 8}}, bundle());
   ASSERT_TRUE(job.ok()) << job.status.detail;
-  const uint64_t id = job.value["id"];
+  const uint64_t id = job.value.jobs.at(0).id;
 
   auto fail = [&](uint64_t worker) {
     auto l = c.lease(worker, 0);
@@ -28,9 +28,9 @@ TEST(Coordinator, FailingWorkersAreKeptOffAndThenTheJobFails) {
   EXPECT_TRUE(!c.lease(a, 0).value) << "worker a failed twice: kept off the job";
   EXPECT_TRUE(c.lease(b, 0).value.has_value()) << "others still get its work";
   ASSERT_TRUE(fail(d));
-  EXPECT_EQ(c.job_status(id).value["state"], "running");
+  EXPECT_EQ(c.job_status(id).value.state, "running");
   ASSERT_TRUE(fail(b));  // the third distinct worker
-  json st = c.job_status(id).value;
+  json st = to_json(c.job_status(id).value);
   EXPECT_EQ(st["state"], "failed");
   EXPECT_NE(st.value("error", "").find("failed on 3 worker(s)"), std::string::npos) << st.dump();
   EXPECT_NE(st.value("error", "").find("no GPU"), std::string::npos) << st.dump();
@@ -45,9 +45,9 @@ TEST(Coordinator, StateSurvivesARestart) {
   {
     Coordinator c(options(dir));
     worker = add_worker(c, "w");
-    auto job = c.submit_job(json{{"tile_size", 8}, {"name", "persist"}, {"seed", 4}}, bundle());
+    auto job = submit(c, json{{"tile_size", 8}, {"name", "persist"}, {"seed", 4}}, bundle());
     ASSERT_TRUE(job.ok()) << job.status.detail;
-    id = job.value["id"];
+    id = job.value.jobs.at(0).id;
     // Render and deliver three units for real, and leave one lease hanging.
     TempDir src;
     src.write("scene.xml", kXml);
@@ -67,10 +67,10 @@ TEST(Coordinator, StateSurvivesARestart) {
       ASSERT_TRUE(up.ok()) << up.status.detail;
     }
     ASSERT_TRUE(c.lease(worker, 0).value.has_value());
-    before = c.job_status(id).value;
+    before = to_json(c.job_status(id).value);
   }
   Coordinator again(options(dir));
-  json after = again.job_status(id).value;
+  json after = to_json(again.job_status(id).value);
   EXPECT_EQ(after["state"], "running");
   EXPECT_EQ(after["name"], "persist");
   EXPECT_EQ(after["units_done"], 3);
@@ -80,8 +80,8 @@ TEST(Coordinator, StateSurvivesARestart) {
   auto l = again.lease(worker, 0);
   ASSERT_TRUE(l.ok()) << l.status.detail;
   EXPECT_TRUE(l.value.has_value());
-  EXPECT_EQ(again.job_status(id).value["reissued_acknowledged_passes"], 0);
-  EXPECT_EQ(again.list_jobs().value["jobs"].size(), 1u);
+  EXPECT_EQ(again.job_status(id).value.reissued_acknowledged_passes, 0);
+  EXPECT_EQ(again.list_jobs().value.size(), 1u);
 }
 
 TEST(Coordinator, FinishedJobIsServedFromItsImageAfterARestart) {
@@ -93,16 +93,16 @@ TEST(Coordinator, FinishedJobIsServedFromItsImageAfterARestart) {
   {
     Coordinator c(options(dir));
     const uint64_t w = add_worker(c, "w");
-    auto job = c.submit_job(json{{"tile_size", 8}, {"seed", 2}}, bundle());
+    auto job = submit(c, json{{"tile_size", 8}, {"seed", 2}}, bundle());
     ASSERT_TRUE(job.ok()) << job.status.detail;
-    id = job.value["id"];
+    id = job.value.jobs.at(0).id;
     while (deliver_one(c, w, *loaded.scene, 2)) {
     }
-    EXPECT_EQ(c.job_status(id).value["state"], "done");
+    EXPECT_EQ(c.job_status(id).value.state, "done");
     exr_before = c.job_image(id, "pfm").value.bytes;
   }
   Coordinator again(options(dir));
-  json st = again.job_status(id).value;
+  json st = to_json(again.job_status(id).value);
   EXPECT_EQ(st["state"], "done");
   EXPECT_EQ(st["units_done"], st["units_total"]);
   auto image = again.job_image(id, "pfm");
@@ -115,12 +115,12 @@ TEST(Coordinator, PriorityCanChangeWhileJobsWait) {
   TempDir dir;
   Coordinator c(options(dir));
   const uint64_t w = add_worker(c, "w");
-  const uint64_t a = c.submit_job(json{{"tile_size", 8}, {"name", "a"}}, bundle()).value["id"];
-  const uint64_t b = c.submit_job(json{{"tile_size", 8}, {"name", "b"}}, bundle()).value["id"];
+  const uint64_t a = submit(c, json{{"tile_size", 8}, {"name", "a"}}, bundle()).value.jobs.at(0).id;
+  const uint64_t b = submit(c, json{{"tile_size", 8}, {"name", "b"}}, bundle()).value.jobs.at(0).id;
   EXPECT_EQ(lease_json(c.lease(w, 0))["job"], a) << "equal priorities: the older job first";
   EXPECT_TRUE(c.set_priority(b, 5).ok());
   EXPECT_EQ(lease_json(c.lease(w, 0))["job"], b);
-  EXPECT_EQ(c.job_status(b).value["priority"], 5);
+  EXPECT_EQ(c.job_status(b).value.priority, 5);
   EXPECT_EQ(c.set_priority(99, 1).code, server::Code::NotFound);
 }
 
@@ -129,23 +129,23 @@ TEST(Coordinator, RetriedJobKeepsItsPassesAndFinishesBitIdentical) {
   LoadResult loaded = load_scene(parse_scene_file(src.write("scene.xml", kXml)), LoadOptions{});
   Coordinator c(options(dir));
   const uint64_t w = add_worker(c, "w");
-  const uint64_t id = c.submit_job(json{{"tile_size", 8}, {"seed", 3}}, bundle()).value["id"];
+  const uint64_t id = submit(c, json{{"tile_size", 8}, {"seed", 3}}, bundle()).value.jobs.at(0).id;
   ASSERT_TRUE(deliver_one(c, w, *loaded.scene, 3));
   ASSERT_TRUE(deliver_one(c, w, *loaded.scene, 3));
   EXPECT_EQ(c.retry_job(id).code, server::Code::Conflict) << "a running job is not retried";
   nlohmann::json l = lease_json(c.lease(w, 0));
   ASSERT_TRUE(c.fail_lease(w, l["id"], "disk full").ok());
-  ASSERT_EQ(c.job_status(id).value["state"], "failed");
+  ASSERT_EQ(c.job_status(id).value.state, "failed");
   ASSERT_TRUE(c.retry_job(id).ok());
-  json st = c.job_status(id).value;
+  json st = to_json(c.job_status(id).value);
   EXPECT_EQ(st["state"], "queued");
   EXPECT_EQ(st["units_done"], 2);
   EXPECT_EQ(st["error"], "");
   while (deliver_one(c, w, *loaded.scene, 3)) {
   }
-  ASSERT_EQ(c.job_status(id).value["state"], "done");
+  ASSERT_EQ(c.job_status(id).value.state, "done");
   // The same image as a job that never failed.
-  const uint64_t clean = c.submit_job(json{{"tile_size", 8}, {"seed", 3}}, bundle()).value["id"];
+  const uint64_t clean = submit(c, json{{"tile_size", 8}, {"seed", 3}}, bundle()).value.jobs.at(0).id;
   while (deliver_one(c, w, *loaded.scene, 3)) {
   }
   EXPECT_EQ(c.job_image(id, "pfm").value.bytes, c.job_image(clean, "pfm").value.bytes);
@@ -155,7 +155,7 @@ TEST(Coordinator, DrainedWorkerGetsNoMoreWork) {
   TempDir dir;
   Coordinator c(options(dir));
   const uint64_t a = add_worker(c, "a"), b = add_worker(c, "b");
-  ASSERT_TRUE(c.submit_job(json{{"tile_size", 8}}, bundle()).ok());
+  ASSERT_TRUE(submit(c, json{{"tile_size", 8}}, bundle()).ok());
   ASSERT_TRUE(c.drain_worker(a).ok());
   EXPECT_EQ(c.lease(a, 0).status.code, server::Code::Gone);
   EXPECT_TRUE(c.lease(b, 0).value.has_value());

@@ -1,5 +1,6 @@
 // Strict parsing of the farm's JSON messages.
 #include "tessera/farm/protocol.h"
+#include "tessera/farm/job_status.h"
 
 #include <gtest/gtest.h>
 
@@ -143,6 +144,40 @@ TEST(Protocol, HeartbeatsRoundTripAndAreStrict) {
   json many = json::array();
   for (size_t i = 0; i <= kMaxHeldLeases; ++i) many.push_back({{"id", i}, {"job", 1}, {"tile", 0}, {"pass", 0}});
   refused(json{{"leases", many}}, "at most");
+}
+
+TEST(JobStatus, JsonNamesEveryFieldAndLeavesOutWhatIsUnknown) {
+  JobStatus st;
+  st.id = 7;
+  st.state = "running";
+  st.units_done = 3;
+  st.workers.push_back({2, "w", 64, 1.0});
+  json j = to_json(st);
+  EXPECT_EQ(j["id"], 7);
+  EXPECT_EQ(j["state"], "running");
+  EXPECT_EQ(j["units_done"], 3);
+  EXPECT_EQ(j["workers"][0]["name"], "w");
+  EXPECT_TRUE(j["noise_estimate"].is_null()) << "null until every pixel has two samples";
+  EXPECT_FALSE(j.contains("leases_issued")) << "left out when the lease log could not be read";
+  st.noise_estimate = 0.25;
+  st.leases_issued = 5;
+  st.reissued_acknowledged_passes = 0;
+  j = to_json(st);
+  EXPECT_EQ(j["noise_estimate"], 0.25);
+  EXPECT_EQ(j["leases_issued"], 5);
+  EXPECT_EQ(j["reissued_acknowledged_passes"], 0);
+  EXPECT_EQ(j["settings"], to_json(st.settings));
+}
+
+TEST(JobStatus, ASubmissionIsTheJobsStatusOrOnePerFrame) {
+  JobStatus a, b;
+  a.id = 1;
+  b.id = 2;
+  EXPECT_EQ(to_json(JobSubmission{{a}, std::nullopt}), to_json(a));
+  const json frames = to_json(JobSubmission{{a, b}, std::pair{10, 11}});
+  ASSERT_EQ(frames["jobs"].size(), 2u);
+  EXPECT_EQ(frames["jobs"][1]["id"], 2);
+  EXPECT_EQ(frames["frames"], json::array({10, 11}));
 }
 
 }  // namespace

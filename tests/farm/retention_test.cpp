@@ -2,6 +2,7 @@
 // their results and image; bundles go once no job uses them; nothing of a queued or running job
 // is touched; an expired job's status says so, across a restart too. The clock is the `now`
 // passed to apply_retention, so nothing sleeps.
+#include "coordinator_fixture.h"
 #include "tessera/farm/build_fingerprint.h"
 #include "tessera/farm/bundle.h"
 #include "tessera/farm/job_scene.h"
@@ -76,12 +77,12 @@ bool deliver_one(Coordinator& c, uint64_t worker, const TestScene& scene) {
 }
 
 uint64_t finished_job(Coordinator& c, uint64_t worker, const TestScene& scene, int seed) {
-  auto job = c.submit_job(json{{"tile_size", 8}, {"seed", seed}}, scene.bundle);
+  auto job = submit(c, json{{"tile_size", 8}, {"seed", seed}}, scene.bundle);
   EXPECT_TRUE(job.ok()) << job.status.detail;
-  const uint64_t id = job.value.value("id", uint64_t(0));
+  const uint64_t id = job.ok() ? job.value.jobs.at(0).id : 0;
   while (deliver_one(c, worker, scene)) {
   }
-  EXPECT_EQ(c.job_status(id).value["state"], "done");
+  EXPECT_EQ(c.job_status(id).value.state, "done");
   return id;
 }
 
@@ -91,7 +92,7 @@ std::string image_file(const TempDir& dir, uint64_t id) {
 std::string bundle_file(const TempDir& dir, const std::string& hash) {
   return (dir.path / "data" / "bundles" / (hash + ".bundle")).string();
 }
-std::string scene_hash(Coordinator& c, uint64_t id) { return c.job_status(id).value["settings"]["scene"]; }
+std::string scene_hash(Coordinator& c, uint64_t id) { return c.job_status(id).value.settings.scene; }
 
 void expect_expired(Coordinator& c, uint64_t id) {
   auto st = c.job_status(id);
@@ -109,50 +110,50 @@ TEST(Retention, AgeLimitDeletesFinishedJobsButNotRunningOnesNorTheirBundle) {
     Coordinator c(options(dir, /*days=*/1, 0));
     const uint64_t w = add_worker(c);
     done = finished_job(c, w, a, 1);
-    running = c.submit_job(json{{"tile_size", 8}, {"seed", 2}}, a.bundle).value["id"];
+    running = submit(c, json{{"tile_size", 8}, {"seed", 2}}, a.bundle).value.jobs.at(0).id;
     ASSERT_TRUE(deliver_one(c, w, a));
-    running_units = c.job_status(running).value["units_done"];
-    ASSERT_EQ(c.job_status(running).value["state"], "running");
+    running_units = c.job_status(running).value.units_done;
+    ASSERT_EQ(c.job_status(running).value.state, "running");
     hash = scene_hash(c, done);
     ASSERT_EQ(scene_hash(c, running), hash) << "the same bundle bytes are stored once";
-    unused_hash = c.upload_scene(unused.bundle).value["hash"];
+    unused_hash = c.upload_scene(unused.bundle).value.hash;
     ASSERT_TRUE(fs::exists(image_file(dir, done)));
 
     auto young = c.apply_retention(wall_now() + 0.5 * 86400);
     ASSERT_TRUE(young.ok()) << young.status.detail;
-    EXPECT_EQ(young.value["deleted_jobs"], 0);
-    EXPECT_EQ(young.value["deleted_bundles"], 0);
-    EXPECT_EQ(c.job_status(done).value["state"], "done");
+    EXPECT_EQ(young.value.deleted_jobs, 0u);
+    EXPECT_EQ(young.value.deleted_bundles, 0u);
+    EXPECT_EQ(c.job_status(done).value.state, "done");
 
     auto old = c.apply_retention(wall_now() + 2 * 86400);
     ASSERT_TRUE(old.ok()) << old.status.detail;
-    EXPECT_EQ(old.value["deleted_jobs"], 1);
-    EXPECT_EQ(old.value["deleted_bundles"], 1) << "the bundle no job used, uploaded over a day ago";
+    EXPECT_EQ(old.value.deleted_jobs, 1u);
+    EXPECT_EQ(old.value.deleted_bundles, 1u) << "the bundle no job used, uploaded over a day ago";
     expect_expired(c, done);
     EXPECT_FALSE(fs::exists(image_file(dir, done)));
     EXPECT_FALSE(fs::exists(bundle_file(dir, unused_hash)));
     // The running job and its bundle (shared with the deleted job) are untouched.
-    json st = c.job_status(running).value;
+    json st = to_json(c.job_status(running).value);
     EXPECT_EQ(st["state"], "running");
     EXPECT_EQ(st["units_done"], running_units);
     EXPECT_TRUE(fs::exists(bundle_file(dir, hash)));
     EXPECT_TRUE(fs::exists(dir.path / "data" / "scenes" / hash));
     EXPECT_NE(c.metrics().find("tessera_retention_deleted_total{what=\"jobs\"} 1"), std::string::npos);
-    EXPECT_EQ(c.list_jobs().value["jobs"].size(), 1u);
+    EXPECT_EQ(c.list_jobs().value.size(), 1u);
     // It still renders to the end.
     while (deliver_one(c, w, a)) {
     }
-    EXPECT_EQ(c.job_status(running).value["state"], "done");
+    EXPECT_EQ(c.job_status(running).value.state, "done");
     EXPECT_TRUE(c.job_image(running, "exr").ok());
   }
   // The tombstone survives a restart; the job that ended just now is kept until it is old too.
   Coordinator again(options(dir, 1, 0));
   expect_expired(again, done);
-  EXPECT_EQ(again.job_status(running).value["state"], "done");
+  EXPECT_EQ(again.job_status(running).value.state, "done");
   auto later = again.apply_retention(wall_now() + 3 * 86400);
   ASSERT_TRUE(later.ok());
-  EXPECT_EQ(later.value["deleted_jobs"], 1);
-  EXPECT_EQ(later.value["deleted_bundles"], 1);
+  EXPECT_EQ(later.value.deleted_jobs, 1u);
+  EXPECT_EQ(later.value.deleted_bundles, 1u);
   expect_expired(again, running);
   EXPECT_FALSE(fs::exists(bundle_file(dir, hash)));
   EXPECT_FALSE(fs::exists(dir.path / "data" / "scenes" / hash));
@@ -170,14 +171,14 @@ TEST(Retention, SizeLimitDeletesTheOldestFinishedJobsFirst) {
     first = finished_job(c, w, b, 1);  // the only user of bundle b
     second = finished_job(c, w, a, 2);
     third = finished_job(c, w, a, 3);
-    running = c.submit_job(json{{"tile_size", 8}, {"seed", 4}}, a.bundle).value["id"];
+    running = submit(c, json{{"tile_size", 8}, {"seed", 4}}, a.bundle).value.jobs.at(0).id;
     ASSERT_TRUE(deliver_one(c, w, a));
     hash_a = scene_hash(c, second);
     hash_b = scene_hash(c, first);
     auto measured = c.apply_retention();
     ASSERT_TRUE(measured.ok());
-    EXPECT_EQ(measured.value["deleted_jobs"], 0) << "no limits: nothing goes";
-    total = measured.value["data_bytes"];
+    EXPECT_EQ(measured.value.deleted_jobs, 0u) << "no limits: nothing goes";
+    total = measured.value.data_bytes;
     EXPECT_GT(total, 0u);
     EXPECT_NE(c.metrics().find("tessera_data_bytes " + std::to_string(total)), std::string::npos);
   }
@@ -186,31 +187,31 @@ TEST(Retention, SizeLimitDeletesTheOldestFinishedJobsFirst) {
     Coordinator c(options(dir, 0, total - 1));
     auto r = c.apply_retention(later);
     ASSERT_TRUE(r.ok()) << r.status.detail;
-    EXPECT_EQ(r.value["deleted_jobs"], 1) << "one job is enough to get under";
+    EXPECT_EQ(r.value.deleted_jobs, 1u) << "one job is enough to get under";
     expect_expired(c, first);
-    EXPECT_EQ(c.job_status(second).value["state"], "done");
-    EXPECT_EQ(c.job_status(third).value["state"], "done");
-    EXPECT_LT(r.value["data_bytes"].get<uint64_t>(), total);
+    EXPECT_EQ(c.job_status(second).value.state, "done");
+    EXPECT_EQ(c.job_status(third).value.state, "done");
+    EXPECT_LT(r.value.data_bytes, total);
   }
   Coordinator c(options(dir, 0, 1));
-  const uint64_t units = c.job_status(running).value["units_done"];
+  const uint64_t units = c.job_status(running).value.units_done;
   auto r = c.apply_retention(later);
   ASSERT_TRUE(r.ok()) << r.status.detail;
-  EXPECT_EQ(r.value["deleted_jobs"], 2);
-  EXPECT_EQ(r.value["deleted_bundles"], 1) << "bundle b, unused now; bundle a is the running job's";
+  EXPECT_EQ(r.value.deleted_jobs, 2u);
+  EXPECT_EQ(r.value.deleted_bundles, 1u) << "bundle b, unused now; bundle a is the running job's";
   expect_expired(c, second);
   expect_expired(c, third);
   EXPECT_FALSE(fs::exists(image_file(dir, third)));
   EXPECT_FALSE(fs::exists(bundle_file(dir, hash_b)));
   EXPECT_TRUE(fs::exists(bundle_file(dir, hash_a)));
-  json st = c.job_status(running).value;
+  json st = to_json(c.job_status(running).value);
   EXPECT_EQ(st["state"], "running");
   EXPECT_EQ(st["units_done"], units);
   // What is left is the running job's: a second pass deletes nothing more.
   auto again = c.apply_retention(later);
-  EXPECT_EQ(again.value["deleted_jobs"], 0);
-  EXPECT_EQ(again.value["deleted_bundles"], 0);
-  EXPECT_EQ(c.job_status(running).value["state"], "running");
+  EXPECT_EQ(again.value.deleted_jobs, 0u);
+  EXPECT_EQ(again.value.deleted_bundles, 0u);
+  EXPECT_EQ(c.job_status(running).value.state, "running");
 }
 
 TEST(Retention, ARetriedJobIsNotFinishedAndIsKept) {
@@ -218,15 +219,15 @@ TEST(Retention, ARetriedJobIsNotFinishedAndIsKept) {
   TestScene a(4);
   Coordinator c(options(dir, 1, 0));
   const uint64_t w = add_worker(c);
-  const uint64_t id = c.submit_job(json{{"tile_size", 8}}, a.bundle).value["id"];
+  const uint64_t id = submit(c, json{{"tile_size", 8}}, a.bundle).value.jobs.at(0).id;
   ASSERT_TRUE(deliver_one(c, w, a));
   ASSERT_TRUE(c.cancel_job(id).ok());
   ASSERT_TRUE(c.retry_job(id).ok());
   auto r = c.apply_retention(wall_now() + 10 * 86400);
   ASSERT_TRUE(r.ok());
-  EXPECT_EQ(r.value["deleted_jobs"], 0);
-  EXPECT_EQ(c.job_status(id).value["state"], "queued");
-  EXPECT_EQ(c.job_status(id).value["units_done"], 1);
+  EXPECT_EQ(r.value.deleted_jobs, 0u);
+  EXPECT_EQ(c.job_status(id).value.state, "queued");
+  EXPECT_EQ(c.job_status(id).value.units_done, 1);
 }
 
 }  // namespace

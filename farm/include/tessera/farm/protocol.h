@@ -46,6 +46,17 @@ nlohmann::json to_json(const JobSettings& s);
 /// `j` must be an object; `require_scene` demands the `scene` field (not for multipart uploads).
 [[nodiscard]] bool job_settings_from_json(const nlohmann::json& j, JobSettings& out, std::string& error,
                                           bool require_scene = true);
+
+/// A submission: the job's settings and, for an animation, its inclusive frame range (one job per
+/// frame N, with `-D frame=N`).
+struct JobRequest {
+  JobSettings settings;
+  std::optional<std::pair<int, int>> frames;
+};
+/// The settings plus "frames": "FIRST-LAST", "FIRST..LAST", a frame number or [FIRST, LAST].
+[[nodiscard]] bool job_request_from_json(const nlohmann::json& j, JobRequest& out, std::string& error,
+                                         bool require_scene = true);
+
 /// Range checks after the scene's defaults are known.
 [[nodiscard]] bool check_job_limits(const JobSettings& s, const JobLimits& limits, std::string& error);
 

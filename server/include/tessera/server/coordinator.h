@@ -8,10 +8,11 @@
 #pragma once
 
 #include "tessera/farm/bundle.h"
+#include "tessera/farm/farm_status.h"
+#include "tessera/farm/job_status.h"
 #include "tessera/farm/protocol.h"
 #include "tessera/server/status.h"
 
-#include <nlohmann/json.hpp>
 
 #include <memory>
 #include <string>
@@ -58,6 +59,11 @@ struct CoordinatorOptions {
   std::vector<std::string> webhook_allow;  // URL prefixes a job's webhook must start with; empty: any  // queued + running; more are refused with 429 until some end
 };
 
+/// What a retention pass did: jobs and bundles deleted, bytes freed, bytes the data dir still holds.
+struct RetentionReport {
+  uint64_t deleted_jobs = 0, deleted_bundles = 0, freed_bytes = 0, data_bytes = 0;
+};
+
 struct ImageBytes {
   std::string bytes, content_type;
 };
@@ -72,7 +78,7 @@ class Coordinator {
   Coordinator& operator=(const Coordinator&) = delete;
 
   // Scenes: bundles stored content-addressed by SHA-256.
-  Result<nlohmann::json> upload_scene(const std::string& bundle);
+  Result<SceneUpload> upload_scene(const std::string& bundle);
   /// Path of the stored bundle file.
   Result<std::string> scene_bundle_path(const std::string& hash);
   /// The stored bundle's bytes (what workers download).
@@ -80,11 +86,11 @@ class Coordinator {
 
   // Jobs. `bundle` non-empty: uploaded in the same request (the settings' scene may be empty).
   // With "frames": "A-B" (or [A, B]) in the settings, one job per frame N in A..B, each with
-  // `-D frame=N` and its own image; the answer is {"jobs": [status, ...]}. A frame that fails to
+  // `-D frame=N` and its own image; the answer has a status per frame. A frame that fails to
   // load cancels the frames already queued and names itself in the error.
-  Result<nlohmann::json> submit_job(const nlohmann::json& settings, const std::string& bundle);
-  Result<nlohmann::json> job_status(uint64_t id);
-  Result<nlohmann::json> list_jobs();
+  Result<JobSubmission> submit_job(const JobRequest& request, const std::string& bundle);
+  Result<JobStatus> job_status(uint64_t id);
+  Result<std::vector<JobSummary>> list_jobs();
   /// format: exr, png or pfm. The partial image while running.
   Result<ImageBytes> job_image(uint64_t id, const std::string& format);
   Status cancel_job(uint64_t id);
@@ -112,22 +118,22 @@ class Coordinator {
   /// Draining: the worker finishes what it renders and gets no more work (its lease polls are
   /// answered 410, on which tessera-worker signs off and exits).
   Status drain_worker(uint64_t worker);
-  Result<nlohmann::json> list_workers();
+  Result<std::vector<WorkerStatus>> list_workers();
 
-  nlohmann::json health();
+  Health health();
   /// Prometheus text format: jobs and workers by state, passes leased/done/expired/failed,
   /// lease-wait and upload latency histograms, bytes in and out, per-worker samples/s.
   std::string metrics();
   /// One retention pass now (as the reaper runs every maintenance_interval), judged at wall time
-  /// `now` (0: the real time; tests pass a later one instead of sleeping). Returns
-  /// {"deleted_jobs", "deleted_bundles", "freed_bytes", "data_bytes"}.
-  Result<nlohmann::json> apply_retention(double now = 0);
+  /// `now` (0: the real time; tests pass a later one instead of sleeping).
+  Result<RetentionReport> apply_retention(double now = 0);
   /// Wakes every long poll and refuses new ones (503); called on SIGTERM.
   void shutdown();
 
  private:
   struct Impl;
-  Result<nlohmann::json> submit_frames(const nlohmann::json& settings, const std::string& bundle);
+  Result<JobSubmission> submit_frames(const JobRequest& request, const std::string& bundle);
+  Result<JobStatus> submit_one(JobSettings settings, const std::string& bundle);
   std::unique_ptr<Impl> impl_;
 };
 
