@@ -120,7 +120,7 @@ void Coordinator::Impl::hold_open_leases(JobState& job) {
     const size_t unit = job.unit(l.tile, l.pass);
     if (job.is_done(unit)) continue;
     job.lease_started(unit);
-    leases[l.id] = LeaseInfo{l.id, job.id(), l.worker, unit, Clock::now() + dead_after()};
+    add_lease(LeaseInfo{l.id, job.id(), l.worker, unit, Clock::now() + dead_after()});
   }
 }
 
@@ -133,9 +133,19 @@ Status Coordinator::Impl::durable(uint64_t ticket) {
   }
 }
 
+void Coordinator::Impl::add_lease(const LeaseInfo& lease) {
+  auto [it, inserted] = leases.try_emplace(lease.id, lease);
+  if (!inserted) {
+    if (--leases_held[it->second.worker] == 0) leases_held.erase(it->second.worker);
+    it->second = lease;
+  }
+  ++leases_held[lease.worker];
+}
+
 void Coordinator::Impl::end_lease(std::map<uint64_t, LeaseInfo>::iterator it) {
   auto job = jobs.find(it->second.job);
   if (job != jobs.end()) job->second->lease_ended(it->second.unit);
+  if (--leases_held[it->second.worker] == 0) leases_held.erase(it->second.worker);
   leases.erase(it);
   work_cv.notify_all();
 }

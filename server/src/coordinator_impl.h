@@ -25,6 +25,7 @@
 #include <map>
 #include <mutex>
 #include <thread>
+#include <unordered_map>
 
 namespace tessera::server {
 
@@ -55,6 +56,9 @@ struct Coordinator::Impl {
   std::condition_variable work_cv;  // new work, a lease expired, a job resumed, shutdown
   std::map<uint64_t, std::unique_ptr<JobState>> jobs;
   std::map<uint64_t, LeaseInfo> leases;
+  std::unordered_map<uint64_t, uint32_t> leases_held;  // by worker: its entries in `leases`
+  /// The one place a lease enters `leases` (replacing one of the same id); end_lease the one it leaves.
+  void add_lease(const LeaseInfo& lease);
   std::map<uint64_t, WorkerInfo> workers;
   uint64_t last_lease_id = 0;  // ids are never reused, also across restarts
   std::atomic<int> waiting_polls{0};

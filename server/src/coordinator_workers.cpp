@@ -40,9 +40,7 @@ void Coordinator::Impl::saw_worker(uint64_t id, WorkerInfo& w) {
 
 void Coordinator::Impl::update_busy(uint64_t id, WorkerInfo& w) {
   if (w.state == WorkerState::Draining || w.state == WorkerState::Gone) return;
-  bool holds = false;
-  for (auto& [lid, l] : leases) holds |= l.worker == id;
-  set_worker_state(id, w, holds ? WorkerState::Busy : WorkerState::Idle);
+  set_worker_state(id, w, leases_held.contains(id) ? WorkerState::Busy : WorkerState::Idle);
 }
 
 WorkerInfo* Coordinator::Impl::find_worker(uint64_t id) {
@@ -135,7 +133,7 @@ Coordinator::Impl::IssuedLease Coordinator::Impl::issue_lease(uint64_t worker, W
         if (!durable) end_lease_id(id);  // not logged: never handed out
       });
   job.lease_started(unit);
-  leases[l.id] = LeaseInfo{l.id, l.job_id, worker, unit, Clock::now() + dead_after()};
+  add_lease(LeaseInfo{l.id, l.job_id, worker, unit, Clock::now() + dead_after()});
   set_worker_state(worker, w, WorkerState::Busy);
   const size_t bytes = to_json(l).dump().size();
   job.lease_bytes += bytes;
@@ -221,7 +219,7 @@ bool Coordinator::Impl::keep_lease(uint64_t worker, const HeldLease& held) {
   if (job->second->is_done(unit)) return false;
   if (it != leases.end()) end_lease(it);  // (an id another worker holds: never two owners)
   job->second->lease_started(unit);
-  leases[held.id] = LeaseInfo{held.id, held.job, worker, unit, Clock::now() + dead_after()};
+  add_lease(LeaseInfo{held.id, held.job, worker, unit, Clock::now() + dead_after()});
   return true;
 }
 
