@@ -25,6 +25,9 @@ std::string compress(std::string_view raw) {
 constexpr size_t kDigestBytes = 32;
 constexpr size_t kPixelBytes = 7 * 8;  // tile_result.h: sum[3], sum_sq[3], count
 
+// Where the pixel sums start in a result's uncompressed bytes (after the header, before the digest).
+size_t pixels_offset(const std::string& raw, size_t pixels) { return raw.size() - kDigestBytes - pixels * kPixelBytes; }
+
 }  // namespace
 
 const SyntheticResults::Variant& SyntheticResults::variant(const Lease& lease, uint64_t& rng) {
@@ -42,15 +45,11 @@ const SyntheticResults::Variant& SyntheticResults::variant(const Lease& lease, u
       }
       p.count = n;
     }
-    std::string raw;
-    raw.reserve(v.pixels.size() * kPixelBytes);
-    for (const PixelSums& p : v.pixels) {
-      raw.append(reinterpret_cast<const char*>(p.sum), sizeof(p.sum));
-      raw.append(reinterpret_cast<const char*>(p.sum_sq), sizeof(p.sum_sq));
-      const uint64_t count = p.count;
-      raw.append(reinterpret_cast<const char*>(&count), sizeof(count));
-    }
-    v.frame = compress(raw);
+    // The pixels' bytes as the real encoder lays them out.
+    begin_tile_result(lease, scratch_);
+    std::copy(v.pixels.begin(), v.pixels.end(), scratch_.film.mutable_pixels().begin());
+    const std::string raw = encode_tile_result(scratch_, kUncompressed);
+    v.frame = compress(std::string_view(raw).substr(pixels_offset(raw, v.pixels.size()), v.pixels.size() * kPixelBytes));
     pool.push_back(std::move(v));
   }
   return pool[pick];
@@ -67,7 +66,7 @@ std::string SyntheticResults::encode(const Lease& lease, uint64_t& rng) {
   // The real format's bytes (and digest), uncompressed; then its header and digest are compressed
   // around the variant's ready frame of pixels.
   const std::string raw = encode_tile_result(scratch_, kUncompressed);
-  const size_t header = raw.size() - kDigestBytes - v.pixels.size() * kPixelBytes;
+  const size_t header = pixels_offset(raw, v.pixels.size());
   return compress(std::string_view(raw).substr(0, header)) + v.frame +
          compress(std::string_view(raw).substr(raw.size() - kDigestBytes));
 }

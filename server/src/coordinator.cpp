@@ -136,7 +136,7 @@ Status Coordinator::Impl::durable(uint64_t ticket) {
 void Coordinator::Impl::add_lease(const LeaseInfo& lease) {
   auto [it, inserted] = leases.try_emplace(lease.id, lease);
   if (!inserted) {
-    if (--leases_held[it->second.worker] == 0) leases_held.erase(it->second.worker);
+    release_held(it->second.worker);
     it->second = lease;
   }
   ++leases_held[lease.worker];
@@ -145,7 +145,7 @@ void Coordinator::Impl::add_lease(const LeaseInfo& lease) {
 void Coordinator::Impl::end_lease(std::map<uint64_t, LeaseInfo>::iterator it) {
   auto job = jobs.find(it->second.job);
   if (job != jobs.end()) job->second->lease_ended(it->second.unit);
-  if (--leases_held[it->second.worker] == 0) leases_held.erase(it->second.worker);
+  release_held(it->second.worker);
   leases.erase(it);
   work_cv.notify_all();
 }

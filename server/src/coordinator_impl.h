@@ -59,6 +59,9 @@ struct Coordinator::Impl {
   std::unordered_map<uint64_t, uint32_t> leases_held;  // by worker: its entries in `leases`
   /// The one place a lease enters `leases` (replacing one of the same id); end_lease the one it leaves.
   void add_lease(const LeaseInfo& lease);
+  void release_held(uint64_t worker) {
+    if (--leases_held[worker] == 0) leases_held.erase(worker);
+  }
   std::map<uint64_t, WorkerInfo> workers;
   uint64_t last_lease_id = 0;  // ids are never reused, also across restarts
   std::atomic<int> waiting_polls{0};

@@ -282,7 +282,7 @@ JobStatus Coordinator::Impl::status_of(const JobState& job) const {
   s.units_total = job.planned_units();
   s.samples_done = job.done_samples();
   s.samples_total = job.total_samples();
-  s.progress = s.samples_total ? double(s.samples_done) / double(s.samples_total) : 1.0;
+  s.progress = job.progress();
   const double end = job.finished > 0 ? job.finished : wall_seconds();
   s.elapsed_seconds = job.started > 0 ? end - job.started : 0;
   s.eta_seconds = s.progress > 0 && s.progress < 1 ? s.elapsed_seconds * (1 - s.progress) / s.progress : 0.0;
@@ -333,7 +333,7 @@ Result<std::vector<JobSummary>> Coordinator::list_jobs() {
   for (auto& [id, job] : impl_->jobs) {
     const JobPlan& p = job->plan();
     list.push_back({id, job->name(), phase_name(job->phase), job->error, job->priority(),
-                    job->total_samples() ? double(job->done_samples()) / double(job->total_samples()) : 1.0,
+                    job->progress(),
                     p.window.width(), p.window.height(), p.settings.spp});
   }
   return list;

@@ -49,6 +49,8 @@ class JobState {
   /// The samples the job will render: all of spp, or those done once it stopped at its target.
   uint64_t total_samples() const { return converged_ ? done_samples_ : total_samples_; }
   uint64_t done_samples() const { return done_samples_; }
+  /// Samples done of the samples the job will have (1 for a job with none).
+  double progress() const { return total_samples() ? double(done_samples_) / double(total_samples()) : 1.0; }
   /// Units the job will render (fewer than num_units() once it stopped at its target error).
   size_t planned_units() const { return converged_ ? done_units_ : num_units(); }
   /// Every planned unit is done.
