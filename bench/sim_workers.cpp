@@ -106,7 +106,9 @@ class Loop {
 
 void Loop::send(Sim& s, client::RequestSpec r) {
   s.out = r.method + " " + r.path + " HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\nContent-Type: " +
-          r.content_type + "\r\nContent-Length: " + std::to_string(r.body.size()) + "\r\n\r\n" + r.body;
+          r.content_type + "\r\nContent-Length: " + std::to_string(r.body.size()) + "\r\n\r\n";
+  s.out.reserve(s.out.size() + r.body.size());
+  s.out += r.body;
   s.sent = 0;
   s.in.clear();
   s.t0 = Clock::now();

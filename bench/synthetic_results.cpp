@@ -15,20 +15,20 @@ uint64_t xorshift(uint64_t& rng) {
   return rng;
 }
 
-std::string compress(std::string_view raw) {
-  std::string out(ZSTD_compressBound(raw.size()), '\0');
-  const size_t n = ZSTD_compress(out.data(), out.size(), raw.data(), raw.size(), 1);
-  out.resize(ZSTD_isError(n) ? 0 : n);
-  return out;
-}
-
-constexpr size_t kDigestBytes = 32;
+constexpr size_t kDigestBytes = kTileResultDigestBytes;
 constexpr size_t kPixelBytes = 7 * 8;  // tile_result.h: sum[3], sum_sq[3], count
 
 // Where the pixel sums start in a result's uncompressed bytes (after the header, before the digest).
 size_t pixels_offset(const std::string& raw, size_t pixels) { return raw.size() - kDigestBytes - pixels * kPixelBytes; }
 
 }  // namespace
+
+std::string SyntheticResults::compress(std::string_view raw) {
+  std::string out(ZSTD_compressBound(raw.size()), '\0');
+  const size_t n = ZSTD_compressCCtx(cctx_.get(), out.data(), out.size(), raw.data(), raw.size(), 1);
+  out.resize(ZSTD_isError(n) ? 0 : n);
+  return out;
+}
 
 const SyntheticResults::Variant& SyntheticResults::variant(const Lease& lease, uint64_t& rng) {
   const uint32_t n = lease.sample_end - lease.sample_begin;
@@ -67,8 +67,11 @@ std::string SyntheticResults::encode(const Lease& lease, uint64_t& rng) {
   // around the variant's ready frame of pixels.
   const std::string raw = encode_tile_result(scratch_, kUncompressed);
   const size_t header = pixels_offset(raw, v.pixels.size());
-  return compress(std::string_view(raw).substr(0, header)) + v.frame +
-         compress(std::string_view(raw).substr(raw.size() - kDigestBytes));
+  std::string out = compress(std::string_view(raw).substr(0, header));
+  out.reserve(out.size() + v.frame.size() + 64);
+  out += v.frame;
+  out += compress(std::string_view(raw).substr(raw.size() - kDigestBytes));
+  return out;
 }
 
 }  // namespace tessera::bench

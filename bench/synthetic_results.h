@@ -6,8 +6,11 @@
 #include "tessera/farm/protocol.h"
 #include "tessera/farm/tile_result.h"
 
+#include <zstd.h>
+
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -27,10 +30,13 @@ class SyntheticResults {
     std::string frame;  // the pixels' bytes, compressed
   };
   const Variant& variant(const Lease& lease, uint64_t& rng);
+  std::string compress(std::string_view raw);
 
   static constexpr size_t kVariants = 8;
   std::map<std::pair<int64_t, uint32_t>, std::vector<Variant>> variants_;  // by (pixels, samples)
   TileResult scratch_;
+  // One compression context for every frame (ZSTD_compress would set up a new one each call).
+  std::unique_ptr<ZSTD_CCtx, size_t (*)(ZSTD_CCtx*)> cctx_{ZSTD_createCCtx(), ZSTD_freeCCtx};
 };
 
 }  // namespace tessera::bench

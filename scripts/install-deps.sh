@@ -12,7 +12,7 @@ build_packages=(
   build-essential cmake ninja-build pkg-config
   nlohmann-json3-dev libtinyobjloader-dev libpugixml-dev libstb-dev libspdlog-dev libfmt-dev
   libtbb-dev libcli11-dev libopenexr-dev libimath-dev zlib1g-dev
-  libcpp-httplib-dev libsqlite3-dev libssl-dev libzstd-dev libarchive-dev
+  libcpp-httplib-dev libsqlite3-dev libssl-dev libzstd-dev libxxhash-dev libarchive-dev
 )
 
 # The tests on top of the build: GoogleTest, the tools test scripts call, the dashboard's browser
@@ -32,7 +32,7 @@ test_packages=(
 # these (--runtime), plus curl for its HEALTHCHECK. tests/deploy checks them against the binaries.
 runtime_packages=(
   libc6 libgcc-s1 libstdc++6 libtbb12 libopenexr-3-1-30 libpugixml1v5 libtinyobjloader2rc10 libstb0
-  libspdlog1.10 libfmt9 zlib1g libzstd1 libarchive13 libssl3 libsqlite3-0 libcpp-httplib0.11
+  libspdlog1.10 libfmt9 zlib1g libzstd1 libxxhash0 libarchive13 libssl3 libsqlite3-0 libcpp-httplib0.11
   ca-certificates curl
 )
 

@@ -222,7 +222,10 @@ bool check_job_limits(const JobSettings& s, const JobLimits& l, std::string& err
   return true;
 }
 
-json to_json(const Lease& l) {
+namespace {
+
+// A lease's fields split in two: its own, and its job's (the same in every lease of the job).
+json lease_own_json(const Lease& l) {
   return {{"id", l.id},
           {"job", l.job_id},
           {"tile", l.tile},
@@ -230,10 +233,27 @@ json to_json(const Lease& l) {
           {"rect", {l.rect.x0, l.rect.y0, l.rect.x1, l.rect.y1}},
           {"sample_begin", l.sample_begin},
           {"sample_end", l.sample_end},
-          {"seconds_to_expiry", l.seconds_to_expiry},
-          {"settings", to_json(l.settings)},
-          {"scene_file", l.scene_file},
-          {"files", l.files}};
+          {"seconds_to_expiry", l.seconds_to_expiry}};
+}
+
+json lease_job_json(const Lease& l) {
+  return {{"settings", to_json(l.settings)}, {"scene_file", l.scene_file}, {"files", l.files}};
+}
+
+}  // namespace
+
+json to_json(const Lease& l) {
+  json j = lease_own_json(l);
+  j.update(lease_job_json(l));
+  return j;
+}
+
+size_t lease_job_part_bytes(const Lease& l) { return lease_job_json(l).dump().size(); }
+
+size_t lease_json_bytes(const Lease& l, size_t job_part_bytes) {
+  // "{own}" and "{job}" make "{own,job}": one byte fewer than the two apart (the order of the
+  // keys does not change the length).
+  return lease_own_json(l).dump().size() + job_part_bytes - 1;
 }
 
 bool lease_from_json(const json& j, Lease& out, std::string& error) {

@@ -135,7 +135,8 @@ Coordinator::Impl::IssuedLease Coordinator::Impl::issue_lease(uint64_t worker, W
   job.lease_started(unit);
   add_lease(LeaseInfo{l.id, l.job_id, worker, unit, Clock::now() + dead_after()});
   set_worker_state(worker, w, WorkerState::Busy);
-  const size_t bytes = to_json(l).dump().size();
+  if (job.lease_job_part_bytes == 0) job.lease_job_part_bytes = lease_job_part_bytes(l);
+  const size_t bytes = lease_json_bytes(l, job.lease_job_part_bytes);
   job.lease_bytes += bytes;
   counters.bytes_out += bytes;
   ++counters.leased;
@@ -282,7 +283,9 @@ uint64_t Coordinator::Impl::commit_result(JobState& job, size_t unit, uint64_t w
       [id = job.id(), tile = result->tile, pass = result->pass, worker, cp, data = cp ? "" : std::string(bytes),
        now = wall_seconds()](Store& st) {
         (void)st.add_result(id, tile, pass, worker, data, now);
-        if (cp) st.save_checkpoint(id, tile, cp->from, cp->passes, encode_checkpoint(id, *cp));
+        // (This pass's row is stored without its bytes and the earlier ones' were dropped: nothing
+        // for the checkpoint to drop, hence `from` = `passes`.)
+        if (cp) st.save_checkpoint(id, tile, cp->passes, cp->passes, encode_checkpoint(id, *cp));
       },
       GroupCommit::Retry::No,
       [this, id = job.id(), unit, worker, result, cp, n = bytes.size()](bool durable) {

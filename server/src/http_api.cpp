@@ -292,7 +292,9 @@ void install_routes(httplib::Server& http, Coordinator& c, uint64_t max_upload_b
   http.Post(R"(/api/v1/workers/(\d+)/results)", [&c](const httplib::Request& req, httplib::Response& res) {
     uint64_t id;
     if (!parse_id(req, 1, id, res)) return;
-    send(res, c.upload_result(id, uint64_t(query_number(req, "lease", 0)), req.body, query_number(req, "next", 0) != 0));
+    Result<ResultAck> ack = c.upload_result(id, uint64_t(query_number(req, "lease", 0)), req.body, query_number(req, "next", 0) != 0);
+    if (!ack.ok()) return send_error(res, ack.status);
+    send_json(res, 200, to_json(ack.value), /*compact=*/true);  // (a worker's hot path, read by programs)
   });
   http.Post(R"(/api/v1/workers/(\d+)/leases/(\d+)/fail)", [&c](const httplib::Request& req, httplib::Response& res) {
     uint64_t id, lease;

@@ -161,6 +161,7 @@ class JobState {
   uint64_t mismatched = 0;  // duplicates whose sums differed from the accepted result's
   uint64_t result_bytes = 0;  // compressed bytes of the accepted results (the network cost)
   uint64_t lease_bytes = 0;   // JSON bytes of the leases handed out
+  size_t lease_job_part_bytes = 0;  // of each lease's job part (0: not measured yet; see protocol.h)
   bool image_pending = false;  // an ended job's image is being written (its film is kept until then)
 
  private:

@@ -119,6 +119,29 @@ TEST(Protocol, LeaseRoundTripAndCacheKey) {
   EXPECT_NE(scene_cache_key(a, "s.xml"), scene_cache_key(a, "t.xml"));
 }
 
+// The coordinator counts a lease's JSON bytes from its own fields plus its job's part measured once:
+// the same count as serializing the whole lease, for any lease of the job.
+TEST(Protocol, LeaseBytesCountedFromTheJobPartAreExact) {
+  Lease first;
+  first.settings.scene = std::string(64, 'd');
+  first.settings.defines["name"] = "caf\u00e9 \"quoted\"";
+  first.scene_file = "sub/scene.xml";
+  first.files = {"sub/scene.xml", "meshes/a.obj", "textures/\u00fcber.png"};
+  const size_t job_part = lease_job_part_bytes(first);
+  for (uint64_t id : {1ull, 99ull, 123456789012ull}) {
+    Lease l = first;
+    l.id = id;
+    l.job_id = id * 7;
+    l.tile = uint32_t(id % 1000);
+    l.pass = uint32_t(id % 13);
+    l.rect = {0, int(id % 100), 32, int(id % 100) + 32};
+    l.sample_begin = 3;
+    l.sample_end = uint32_t(id % 77) + 4;
+    l.seconds_to_expiry = id == 1 ? 15.0 : 7.25;
+    EXPECT_EQ(lease_json_bytes(l, job_part), to_json(l).dump().size()) << id;
+  }
+}
+
 TEST(Protocol, HeartbeatsRoundTripAndAreStrict) {
   const std::vector<HeldLease> held = {{31, 1, 5, 2}, {32, 1, 6, 2}};
   std::vector<HeldLease> back;

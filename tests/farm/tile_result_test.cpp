@@ -1,6 +1,7 @@
 // The tile-result wire format: exact round trip (compressed, in concatenated frames, or stored as it
 // is), and every kind of damage refused.
 #include "tessera/farm/tile_result.h"
+#include "tessera/farm/sha256.h"
 
 #include <gtest/gtest.h>
 #include <zstd.h>
@@ -97,7 +98,7 @@ std::string zstd_frame(std::string_view raw) {
 TEST(TileResult, StoredUncompressedRoundTripsAndIsChecked) {
   const TileResult in = sample_result();
   const std::string raw = encode_tile_result(in, kUncompressed);
-  EXPECT_EQ(raw.size(), size_t(13 * 9 * 56 + 128));
+  EXPECT_EQ(raw.size(), size_t(96 + 13 * 9 * 56 + kTileResultDigestBytes));
   EXPECT_EQ(raw.substr(0, 4), "TSTR");
   TileResult out;
   std::string error;
@@ -109,6 +110,28 @@ TEST(TileResult, StoredUncompressedRoundTripsAndIsChecked) {
   EXPECT_FALSE(decode_tile_result(bad, out, error));
   EXPECT_NE(error.find("checksum"), std::string::npos) << error;
   EXPECT_FALSE(decode_tile_result(raw.substr(0, raw.size() - 8), out, error));
+}
+
+// A data directory written before the format's checksum became XXH3-128 holds version-1 results
+// and checkpoints, which end in a SHA-256: they are still read, and still checked.
+TEST(TileResult, ReadsVersionOneWithSha256) {
+  const TileResult in = sample_result();
+  std::string v1 = encode_tile_result(in, kUncompressed);
+  v1.resize(v1.size() - kTileResultDigestBytes);
+  const uint32_t version = 1;
+  std::memcpy(v1.data() + 4, &version, 4);
+  const Sha256Digest digest = sha256(v1);
+  v1.append(reinterpret_cast<const char*>(digest.data()), digest.size());
+  TileResult out;
+  std::string error;
+  ASSERT_TRUE(decode_tile_result(v1, out, error)) << error;
+  EXPECT_TRUE(same_result(in, out));
+  v1[300] ^= 0x04;
+  EXPECT_FALSE(decode_tile_result(v1, out, error));
+  EXPECT_NE(error.find("checksum"), std::string::npos) << error;
+  std::memcpy(v1.data() + 4, "\x03\0\0\0", 4);
+  EXPECT_FALSE(decode_tile_result(v1, out, error));
+  EXPECT_NE(error.find("version 3"), std::string::npos) << error;
 }
 
 TEST(TileResult, ConcatenatedFramesDecodeAsOne) {

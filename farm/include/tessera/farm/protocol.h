@@ -74,6 +74,10 @@ struct Lease {
 };
 
 nlohmann::json to_json(const Lease& l);
+/// Bytes of to_json(l).dump() without serializing the job's part of it again: `job_part_bytes` is
+/// lease_job_part_bytes() of any lease of the same job (its settings, scene file and files).
+size_t lease_json_bytes(const Lease& l, size_t job_part_bytes);
+size_t lease_job_part_bytes(const Lease& l);
 [[nodiscard]] bool lease_from_json(const nlohmann::json& j, Lease& out, std::string& error);
 
 struct WorkerHello {

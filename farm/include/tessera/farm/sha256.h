@@ -1,5 +1,5 @@
 // SHA-256 (OpenSSL) for content addressing: scene bundles are stored and cached by the hex digest
-// of their bytes, and tile results carry one so a corrupt upload is refused.
+// of their bytes. (Tile results carry a cheaper checksum: tile_result.h.)
 #pragma once
 
 #include <array>

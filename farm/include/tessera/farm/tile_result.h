@@ -6,7 +6,8 @@
 //   u64 job id, u32 tile index, u32 pass index, i32 x0 y0 x1 y1, u32 sample_begin, sample_end,
 //   u64 samples, camera_rays, bounce_rays, shadow_rays, nonfinite, f64 render seconds,
 //   per pixel (row-major over the rect): f64 sum[3], f64 sum_sq[3], u64 count,
-//   32-byte SHA-256 of everything above.
+//   16-byte XXH3-128 checksum of everything above (big-endian canonical form); format version 1,
+//   still read, ended in a 32-byte SHA-256 instead.
 // The coordinator adds decoded tiles to its Film exactly as render() does, so the stitched image is
 // bit-identical to a local render (render/renderer.h).
 #pragma once
@@ -26,6 +27,9 @@ struct TileResult {
   double seconds = 0;  // time the worker spent rendering it
   FilmTile film;       // rect, sums and counters
 };
+
+/// Bytes of the checksum that ends a result's uncompressed bytes.
+inline constexpr size_t kTileResultDigestBytes = 16;
 
 /// The `level` that stores a result uncompressed (it starts with the magic, not a zstd frame): for
 /// bytes written locally and often (the coordinator's checkpoints), where compressing would cost
