@@ -22,11 +22,11 @@ constexpr uint32_t kVersion = 2;
 constexpr uint32_t kVersionSha256 = 1;
 constexpr size_t kHeaderBytes = 4 + 4 + 8 + 4 + 4 + 16 + 8 + 5 * 8 + 8;
 constexpr size_t kPixelBytes = 7 * 8;
-constexpr size_t kMaxDigestBytes = 32;
+constexpr size_t kMaxDigestBytes = sizeof(Sha256Digest);
 static_assert(sizeof(PixelSums) == kPixelBytes && std::is_trivially_copyable_v<PixelSums>,
               "pixel sums are copied to and from the format as they lie in memory");
 
-size_t digest_bytes(uint32_t version) { return version == kVersionSha256 ? 32 : kTileResultDigestBytes; }
+size_t digest_bytes(uint32_t version) { return version == kVersionSha256 ? sizeof(Sha256Digest) : kTileResultDigestBytes; }
 
 // The checksum of `bytes` as the format stores it (XXH3-128, big-endian canonical form).
 std::array<char, kTileResultDigestBytes> checksum(std::string_view bytes) {

@@ -99,9 +99,9 @@ void normalise_body_headers(httplib::Request& req) {
 
 // A service's answer as JSON: the farm's types' to_json (farm/protocol.h, job_status.h, farm_status.h).
 template <class T>
-void send(httplib::Response& res, const Result<T>& r, int ok_status = 200) {
+void send(httplib::Response& res, const Result<T>& r, int ok_status = 200, bool compact = false) {
   if (!r.ok()) return send_error(res, r.status);
-  send_json(res, ok_status, to_json(r.value));
+  send_json(res, ok_status, to_json(r.value), compact);
 }
 
 // A list answered as {"<key>": [...]}.
@@ -292,9 +292,9 @@ void install_routes(httplib::Server& http, Coordinator& c, uint64_t max_upload_b
   http.Post(R"(/api/v1/workers/(\d+)/results)", [&c](const httplib::Request& req, httplib::Response& res) {
     uint64_t id;
     if (!parse_id(req, 1, id, res)) return;
-    Result<ResultAck> ack = c.upload_result(id, uint64_t(query_number(req, "lease", 0)), req.body, query_number(req, "next", 0) != 0);
-    if (!ack.ok()) return send_error(res, ack.status);
-    send_json(res, 200, to_json(ack.value), /*compact=*/true);  // (a worker's hot path, read by programs)
+    // (Compact, as the lease's answer: a worker's hot path, read by programs.)
+    send(res, c.upload_result(id, uint64_t(query_number(req, "lease", 0)), req.body, query_number(req, "next", 0) != 0),
+         200, /*compact=*/true);
   });
   http.Post(R"(/api/v1/workers/(\d+)/leases/(\d+)/fail)", [&c](const httplib::Request& req, httplib::Response& res) {
     uint64_t id, lease;
