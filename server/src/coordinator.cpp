@@ -68,6 +68,7 @@ Coordinator::Coordinator(CoordinatorOptions options) : impl_(std::make_unique<Im
   // (Under the lock: the group commit's callbacks and image writes take it too.)
   std::lock_guard<std::mutex> lock(s.mu);
   s.last_lease_id = s.store.last_lease_seq();
+  s.workers_before_start = s.store.last_worker_id();
   for (JobRow& row : s.store.jobs()) {
     JobPhase phase;
     if (!parse_phase(row.state, phase)) phase = JobPhase::Failed;
@@ -235,10 +236,12 @@ void Coordinator::Impl::finish_job(JobState& job, bool notify) {
   ImageAttributes attributes = {{"tessera_version", TESSERA_VERSION}, {"tessera_job", std::to_string(job.id())},
                                 {"tessera_spp", std::to_string(image_spp(job))},
                                 {"tessera_seed", std::to_string(job.plan().settings.seed)}};
-  background.push([this, id = job.id(), image = job.image(), attributes = std::move(attributes), notify] {
+  background.push([this, id = job.id(), attributes = std::move(attributes), notify] {
     std::string error;
     try {
-      write_image_durably(image_path(id), image, attributes, opt.data_dir);
+      std::optional<Image> image = film_image(id, /*consistent=*/true);
+      if (!image) return;  // (the job was deleted meanwhile)
+      write_image_durably(image_path(id), *image, attributes, opt.data_dir);
     } catch (const std::exception& e) {
       error = e.what();
     }
@@ -254,6 +257,39 @@ void Coordinator::Impl::finish_job(JobState& job, bool notify) {
     log_event(spdlog::level::debug, "job.image_saved", {{"job", id}});
     if (notify) send_webhook(j);
   });
+}
+
+std::optional<Image> Coordinator::Impl::film_image(uint64_t id, bool consistent) {
+  constexpr int kBandPixels = 1 << 18;  // about a millisecond of conversion under the lock
+  const auto find = [&]() -> const JobState* {
+    auto it = jobs.find(id);
+    return it != jobs.end() && it->second->has_film() ? it->second.get() : nullptr;
+  };
+  int width = 0, height = 0;
+  {
+    std::lock_guard<std::mutex> lock(mu);
+    const JobState* job = find();
+    if (!job) return std::nullopt;
+    width = job->plan().window.width();
+    height = job->plan().window.height();
+  }
+  Image image(width, height, 3);  // (allocated off the lock)
+  const int band = std::max(1, kBandPixels / std::max(1, width));
+  uint64_t changes = 0;
+  for (int y = 0; y < height;) {
+    std::lock_guard<std::mutex> lock(mu);
+    const JobState* job = find();
+    if (!job) return std::nullopt;
+    if (y == 0) {
+      changes = job->film_changes();
+    } else if (consistent && job->film_changes() != changes) {
+      y = 0;  // (the film changed: convert it again from the top)
+      continue;
+    }
+    job->image_rows(image, y, std::min(height, y + band));
+    y += band;
+  }
+  return image;
 }
 
 void Coordinator::Impl::send_webhook(const JobState& job) {

@@ -64,6 +64,7 @@ struct Coordinator::Impl {
   }
   std::map<uint64_t, WorkerInfo> workers;
   uint64_t last_lease_id = 0;  // ids are never reused, also across restarts
+  uint64_t workers_before_start = 0;  // ids up to this were registered with an earlier process
   std::atomic<int> waiting_polls{0};
   bool stopping = false;
   std::thread reaper;
@@ -80,8 +81,11 @@ struct Coordinator::Impl {
 
   std::string bundle_path(const std::string& hash) const;
   std::string scene_dir(const std::string& hash) const;
-  /// Under `mu`: the worker, loaded from the store after a restart; null if unknown.
+  /// Under `mu`: the worker; null if unknown (or registered before a restart and not adopted).
   WorkerInfo* find_worker(uint64_t id);
+  /// Not under `mu`: a worker registered with the previous process keeps its id after a restart;
+  /// its row is read from the store (outside the lock) the first time it is heard from.
+  void adopt_worker(uint64_t id);
   /// Under `mu`: the one place a worker's state changes (worker_state.h), with its event.
   void set_worker_state(uint64_t id, WorkerInfo& w, WorkerState to);
   /// Under `mu`: the worker was heard from; a lost one is live again.
@@ -153,6 +157,11 @@ struct Coordinator::Impl {
   /// background (off the lock); then its film is dropped and (with `notify`) its webhook called.
   /// An image a full disk kept from being written is tried again by the retention pass.
   void finish_job(JobState& job, bool notify);
+  /// Not under `mu`: the job's image from its film, converted a band of rows at a time so that a
+  /// large film never holds the lock for long; nullopt if the job or its film is gone.
+  /// `consistent`: start again if the film changes between bands (an ended job's image); else a
+  /// running job's preview may join bands a few results apart.
+  std::optional<Image> film_image(uint64_t id, bool consistent);
   /// Under `mu`: the job's webhook, if it has one, with its status.
   void send_webhook(const JobState& job);
   std::string image_path(uint64_t job) const;

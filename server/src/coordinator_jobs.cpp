@@ -346,13 +346,17 @@ Result<ImageBytes> Coordinator::job_image(uint64_t id, const std::string& format
   Image image;
   JobPlan plan;
   uint32_t spp = 0;
+  bool from_film = false;
   {
     std::lock_guard<std::mutex> lock(s.mu);
     auto it = s.jobs.find(id);
     if (it == s.jobs.end()) return s.missing_job(id);
     plan = it->second->plan();
     spp = image_spp(*it->second);
-    if (it->second->has_film()) image = it->second->image();
+    from_film = it->second->has_film();
+  }
+  if (from_film) {  // (or released meanwhile, once its image is on disk)
+    if (std::optional<Image> converted = s.film_image(id, /*consistent=*/false)) image = std::move(*converted);
   }
   if (image.width() == 0) {  // an ended job: its image is on disk
     try {

@@ -45,14 +45,22 @@ void Coordinator::Impl::update_busy(uint64_t id, WorkerInfo& w) {
 
 WorkerInfo* Coordinator::Impl::find_worker(uint64_t id) {
   auto it = workers.find(id);
-  if (it != workers.end()) return &it->second;
-  // After a restart: a worker registered with the previous process keeps its id.
+  return it == workers.end() ? nullptr : &it->second;
+}
+
+void Coordinator::Impl::adopt_worker(uint64_t id) {
+  if (id == 0 || id > workers_before_start) return;  // (registered with this process, or never)
+  {
+    std::lock_guard<std::mutex> lock(mu);
+    if (workers.contains(id)) return;
+  }
   std::optional<WorkerRow> row = store.worker(id);
-  if (!row) return nullptr;
-  WorkerInfo& w = workers[id];
-  w.row = *row;
-  w.last_seen = Clock::now();
-  return &w;
+  if (!row) return;
+  std::lock_guard<std::mutex> lock(mu);
+  auto [it, added] = workers.try_emplace(id);
+  if (!added) return;
+  it->second.row = std::move(*row);
+  it->second.last_seen = Clock::now();
 }
 
 Result<Registration> Coordinator::register_worker(const WorkerHello& hello) {
@@ -159,6 +167,7 @@ Result<std::optional<Lease>> Coordinator::lease(uint64_t worker, double wait_sec
   } slot{s.waiting_polls};
   if (s.waiting_polls.fetch_add(1) >= s.opt.max_waiting_polls || !(wait_seconds >= 0)) wait_seconds = 0;  // NaN too
   const auto t0 = Clock::now();
+  s.adopt_worker(worker);
   std::unique_lock<std::mutex> lock(s.mu);
   WorkerInfo* w = s.find_worker(worker);
   if (!w) return unknown_worker(worker);
@@ -188,6 +197,7 @@ Result<std::optional<Lease>> Coordinator::lease(uint64_t worker, double wait_sec
 
 Result<std::vector<uint64_t>> Coordinator::heartbeat(uint64_t worker, const std::vector<HeldLease>& held) {
   Impl& s = *impl_;
+  s.adopt_worker(worker);
   std::lock_guard<std::mutex> lock(s.mu);
   WorkerInfo* w = s.find_worker(worker);
   if (!w) return unknown_worker(worker);
@@ -310,6 +320,7 @@ Result<ResultAck> Coordinator::upload_result(uint64_t worker, uint64_t /*lease*/
   std::string error;
   if (!decode_tile_result(bytes, *result, error, s.opt.limits.max_pixels))
     return make_error(Code::BadRequest, "bad_result", error);
+  s.adopt_worker(worker);
   // Decided here and appended to the group commit; its callback adds it to the job once durable.
   ResultAck ack{/*accepted=*/true, /*duplicate=*/false, next, std::nullopt};
   uint64_t ticket = 0;
@@ -390,6 +401,7 @@ Status Coordinator::fail_lease(uint64_t worker, uint64_t lease, const std::strin
 
 Status Coordinator::sign_off(uint64_t worker) {
   Impl& s = *impl_;
+  s.adopt_worker(worker);
   uint64_t ticket = 0;
   {
     std::lock_guard<std::mutex> lock(s.mu);
@@ -406,6 +418,7 @@ Status Coordinator::sign_off(uint64_t worker) {
 
 Status Coordinator::drain_worker(uint64_t worker) {
   Impl& s = *impl_;
+  s.adopt_worker(worker);
   std::lock_guard<std::mutex> lock(s.mu);
   WorkerInfo* w = s.find_worker(worker);
   if (!w) return unknown_worker(worker);

@@ -14,6 +14,8 @@ constexpr size_t kFailureHistory = 64;
 // A batch of retried records that failed again (the disk is still full) is tried again this often
 // when nothing new arrives.
 constexpr auto kRetryPause = std::chrono::milliseconds(500);
+// The most records one request appends (a result and the next lease sent with its answer).
+constexpr size_t kOneRequest = 2;
 }  // namespace
 
 GroupCommit::GroupCommit(Store& store, Runner runner, std::chrono::microseconds min_interval, size_t max_batch)
@@ -36,9 +38,9 @@ uint64_t GroupCommit::append(Write write, Retry retry, Done done) {
   std::lock_guard<std::mutex> lock(mu_);
   const uint64_t ticket = ++appended_;
   queue_.push_back({ticket, std::move(write), retry, std::move(done)});
-  // The writer waits for a first record, a full batch, or (retried records queued) anything new;
-  // not woken for each record in between.
-  if (queue_.size() == 1 || queue_.size() >= max_batch_ || queue_.front().ticket <= finished_)
+  // The writer waits for a first record, a full batch, as many as it wants (see fill()), or
+  // (retried records queued) anything new; not woken for each record in between.
+  if (queue_.size() == 1 || queue_.size() >= std::min(wanted_, max_batch_) || queue_.front().ticket <= finished_)
     queued_cv_.notify_one();
   return ticket;
 }
@@ -86,8 +88,7 @@ void GroupCommit::run() {
     queued_cv_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
     // Stopping: what is queued is committed first; records only waiting for a retry are given up.
     if (queue_.empty() || (stopping_ && queue_.back().ticket <= finished_)) return;
-    // Busy: let the batch fill until the interval since the last commit's start is over.
-    queued_cv_.wait_until(lock, last_start + min_interval_, [&] { return stopping_ || queue_.size() >= max_batch_; });
+    if (busy_) fill(lock, last_start);
     last_start = std::chrono::steady_clock::now();
     while (!queue_.empty() && batch.size() < max_batch_) {
       batch.push_back(std::move(queue_.front()));
@@ -96,6 +97,10 @@ void GroupCommit::run() {
     lock.unlock();
     commit(batch);  // the records' own work and the fsync, with appends going on meanwhile
     lock.lock();
+    // Busy: more than one request's records (a result and the lease sent with its answer) in the
+    // batch, or more decided while it committed.
+    busy_ = batch.size() > kOneRequest || !queue_.empty();
+    last_batch_ = batch.size();
     batch.clear();
     for (Waiter* w : waiters_)  // (under the lock: a waiter leaves, and its cv goes, only after it)
       if (w->ticket <= finished_) w->cv.notify_one();
@@ -103,6 +108,16 @@ void GroupCommit::run() {
     if (!queue_.empty() && queue_.back().ticket <= finished_)
       queued_cv_.wait_for(lock, kRetryPause, [&] { return stopping_ || queue_.back().ticket > finished_; });
   }
+}
+
+void GroupCommit::fill(std::unique_lock<std::mutex>& lock, std::chrono::steady_clock::time_point last_start) {
+  // The batch fills until the interval since the last commit's start is over; then, for up to one
+  // more interval, until it holds as many records as the last batch: the clients that batch
+  // answered are mostly on their way back, and one commit for all of them is one fsync, not two.
+  queued_cv_.wait_until(lock, last_start + min_interval_, [&] { return stopping_ || queue_.size() >= max_batch_; });
+  wanted_ = std::min(last_batch_, max_batch_);
+  queued_cv_.wait_until(lock, last_start + 2 * min_interval_, [&] { return stopping_ || queue_.size() >= wanted_; });
+  wanted_ = SIZE_MAX;
 }
 
 void GroupCommit::commit(std::vector<Record>& batch) {

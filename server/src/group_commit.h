@@ -36,10 +36,11 @@ class GroupCommit {
   using Runner = std::function<void(const std::function<void()>& callbacks)>;
   enum class Retry { No, UntilDurable };
 
-  /// `min_interval`: a commit starts at least this long after the previous one started (records
-  /// arriving meanwhile join it): under load, fewer and larger commits for a latency of at most
-  /// that much; an idle writer commits a lone record at once. `max_batch`: records per
-  /// transaction at most (bounds a batch's latency and WAL growth).
+  /// `min_interval`: under load (the previous batch held more than one request's records, or more
+  /// arrived while it committed), a commit starts at least this long after the previous one
+  /// started, and records arriving meanwhile join it; it waits up to one more interval for as many
+  /// records as the previous batch held. Fewer and larger commits for a latency of at most two
+  /// intervals. Otherwise (an idle writer, or one client at a time) a record is committed at once. `max_batch`: records per transaction at most (bounds a batch's latency and WAL growth).
   explicit GroupCommit(Store& store, Runner runner = {}, std::chrono::microseconds min_interval = {},
                        size_t max_batch = 256);
   /// Commits what is queued, then stops the writer.
@@ -71,6 +72,7 @@ class GroupCommit {
     std::exception_ptr error;
   };
   void run();
+  void fill(std::unique_lock<std::mutex>& lock, std::chrono::steady_clock::time_point last_start);
   void commit(std::vector<Record>& batch);
   void run_callbacks(std::vector<Record>& batch, bool durable);
   bool failed(uint64_t ticket, std::exception_ptr& error) const;
@@ -92,6 +94,9 @@ class GroupCommit {
   std::deque<Failure> failures_;  // the newest few, for waiters that have not looked yet
   uint64_t appended_ = 0, finished_ = 0;
   bool stopping_ = false;
+  bool busy_ = false;  // under load: wait for `min_interval` (see the constructor)
+  size_t last_batch_ = 0;  // records in the last batch
+  size_t wanted_ = SIZE_MAX;  // records the writer is waiting for (see fill())
   Stats stats_;
   std::thread thread_;
 };

@@ -53,6 +53,10 @@ Image JobState::image() const {
   return Image(plan_.window.width(), plan_.window.height(), 3);
 }
 
+void JobState::image_rows(Image& img, int row_begin, int row_end) const {
+  if (film_) film_->to_image_rows(img, row_begin, row_end);  // (else black, as allocated)
+}
+
 NoiseEstimate JobState::noise() const {
   if (!film_) return noise_ ? *noise_ : NoiseEstimate{std::numeric_limits<double>::infinity(), 0};
   if (!noise_ || noise_units_ != done_units_) {
@@ -116,6 +120,7 @@ bool JobState::add_result(size_t unit, FilmTile&& tile, uint64_t worker) {
   for (auto it = waiting_.find(this->unit(t, next_pass_[t])); it != waiting_.end();
        it = waiting_.find(this->unit(t, next_pass_[t]))) {
     if (film_) film_->add_tile(it->second);
+    ++film_changes_;
     tile_counters_[t] += it->second.counters;
     waiting_.erase(it);
     if (++next_pass_[t] == passes_.size()) break;
@@ -174,6 +179,7 @@ std::optional<JobState::Checkpoint> JobState::checkpoint_with(size_t u, const Fi
 void JobState::restore_checkpoint(uint32_t t, uint32_t passes, FilmTile&& sums) {
   if (!film_ && !film_released_) film_ = std::make_unique<Film>(plan_.window, plan_.full_width, plan_.full_height);
   if (film_) film_->add_tile(sums);
+  ++film_changes_;
   counters_ += sums.counters;
   tile_counters_[t] = sums.counters;
   next_pass_[t] = folded_[t] = passes;

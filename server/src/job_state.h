@@ -131,6 +131,10 @@ class JobState {
 
   /// Mean radiance over the film window (zero where no pass has arrived). Only with has_film().
   Image image() const;
+  /// Rows [row_begin, row_end) of image() into `img` (of the window's size). Only with has_film().
+  void image_rows(Image& img, int row_begin, int row_end) const;
+  /// Counts every change of the film's sums (a result or checkpoint added).
+  uint64_t film_changes() const { return film_changes_; }
   /// The sums so far; only once a result has arrived (film_allocated()).
   const Film& film() const { return *film_; }
   /// The film is allocated when the first result arrives, not at submission: a queue of jobs (a
@@ -196,6 +200,7 @@ class JobState {
   std::map<uint64_t, uint64_t> samples_by_worker_;
   std::unique_ptr<Film> film_;
   bool film_released_ = false;
+  uint64_t film_changes_ = 0;
   RenderCounters counters_;
 };
 

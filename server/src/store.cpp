@@ -239,6 +239,12 @@ void Store::log_lease(uint64_t seq, uint64_t job, uint32_t tile, uint32_t pass, 
   if (!st.step() && st.constraint()) fail(db_, "lease " + std::to_string(seq) + " logged twice");
 }
 
+uint64_t Store::last_worker_id() {
+  Stmt st(rd_, "SELECT COALESCE((SELECT seq FROM sqlite_sequence WHERE name = 'workers'), 0)");
+  st.step();
+  return uint64_t(st.i(0));
+}
+
 uint64_t Store::last_lease_seq() {
   // AUTOINCREMENT's counter: never lowered, also once retention has deleted the newest leases.
   Stmt st(rd_, "SELECT COALESCE((SELECT seq FROM sqlite_sequence WHERE name = 'leases'), 0)");

@@ -130,21 +130,58 @@ TEST(GroupCommit, AFailedBatchFailsItsTicketsAndRetriesOnlyRecordsMarkedForRetry
   EXPECT_EQ(commits.stats().failed_batches, 1u);
 }
 
+TEST(GroupCommit, OneClientAtATimeIsCommittedAtOnce) {
+  TempDb db;
+  Store store(db.path());
+  GroupCommit commits(store, {}, std::chrono::milliseconds(300));
+  // Each record waited for before the next is appended: nothing to gather, so no interval.
+  const auto t0 = std::chrono::steady_clock::now();
+  for (uint64_t seq = 1; seq <= 5; ++seq) commits.wait(commits.append(lease_record(seq)));
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::milliseconds(250));
+  EXPECT_EQ(commits.stats().commits, 5u);
+}
+
 TEST(GroupCommit, UnderLoadACommitStartsAtMostOncePerInterval) {
   TempDb db;
   Store store(db.path());
   GroupCommit commits(store, {}, std::chrono::milliseconds(300));
-  // Idle: a lone record commits at once.
+  // Records appended while a batch commits: the next commit waits for the interval since that
+  // batch's start, and everything appended until then shares it.
   const auto t0 = std::chrono::steady_clock::now();
-  commits.wait(commits.append(lease_record(1)));
-  EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::milliseconds(250));
-  // Busy: records appended within the interval wait for its end and share one commit.
+  Blocker blocker;
+  (void)blocker.append(commits);
+  (void)commits.append(lease_record(1));
+  blocker.release();
   uint64_t last = 0;
   for (uint64_t seq = 2; seq <= 11; ++seq) last = commits.append(lease_record(seq));
   commits.wait(last);
   EXPECT_GE(std::chrono::steady_clock::now() - t0, std::chrono::milliseconds(290));
   EXPECT_EQ(commits.stats().commits, 2u);
   EXPECT_EQ(store.leases_issued(1), 11u);
+}
+
+TEST(GroupCommit, UnderLoadACommitWaitsUpToAnotherIntervalForAsManyRecordsAsTheLast) {
+  using namespace std::chrono_literals;
+  TempDb db;
+  Store store(db.path());
+  GroupCommit commits(store, {}, 300ms);
+  // A batch of five (appended while the writer was held): the writer is under load.
+  Blocker blocker;
+  (void)blocker.append(commits);
+  uint64_t last = 0;
+  for (uint64_t seq = 1; seq <= 5; ++seq) last = commits.append(lease_record(seq));
+  blocker.release();
+  commits.wait(last);
+  const auto batch_start = std::chrono::steady_clock::now();  // (about when that batch started)
+  // Four come back at once and the fifth late, after the interval but within two: one commit.
+  for (uint64_t seq = 6; seq <= 9; ++seq) last = commits.append(lease_record(seq));
+  std::this_thread::sleep_until(batch_start + 420ms);
+  const uint64_t late = commits.append(lease_record(10));
+  commits.wait(last);
+  EXPECT_GE(std::chrono::steady_clock::now() - batch_start, 400ms) << "the first four did not wait for the fifth";
+  commits.wait(late);
+  EXPECT_EQ(commits.stats().commits, 3u);
+  EXPECT_EQ(store.leases_issued(1), 10u);
 }
 
 TEST(GroupCommit, WhatWasAppendedIsCommittedWhenTheWriterStops) {

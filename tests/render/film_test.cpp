@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -35,6 +36,23 @@ TEST(Film, MeanVarianceAndCounts) {
   EXPECT_EQ(img.rgb(0, 0), Rgb());
   std::vector<float> rgb = film.to_rgb();
   EXPECT_EQ(rgb[(1 * 4 + 1) * 3], 2.f);
+}
+
+TEST(Film, ImageConvertedInBandsIsTheWholeImage) {
+  // A window off the origin, every pixel different.
+  Film film(TileRect{3, 2, 10, 9}, 12, 12);
+  FilmTile tile(TileRect{3, 2, 10, 9});
+  for (int y = 2; y < 9; ++y)
+    for (int x = 3; x < 10; ++x) tile.add_sample({x, y}, Rgb(float(x), float(y), float(x * y)));
+  film.add_tile(tile);
+  const Image whole = film.to_image();
+  Image bands(film.width(), film.height(), 3);
+  for (int y = 0; y < film.height(); y += 3) film.to_image_rows(bands, y, std::min(film.height(), y + 3));
+  for (int y = 0; y < film.height(); ++y)
+    for (int x = 0; x < film.width(); ++x) {
+      EXPECT_EQ(bands.rgb(x, y), whole.rgb(x, y)) << x << "," << y;
+      EXPECT_EQ(whole.rgb(x, y), Rgb(float(x + 3), float(y + 2), float((x + 3) * (y + 2))));
+    }
 }
 
 TEST(Film, NonFiniteSamplesDroppedAndCounted) {

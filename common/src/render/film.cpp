@@ -88,9 +88,14 @@ std::vector<float> Film::to_rgb() const {
 
 Image Film::to_image() const {
   Image img(width(), height(), 3);
-  for (int y = window_.y0; y < window_.y1; ++y)
-    for (int x = window_.x0; x < window_.x1; ++x) img.set_rgb(x - window_.x0, y - window_.y0, mean({x, y}));
+  to_image_rows(img, 0, height());
   return img;
+}
+
+void Film::to_image_rows(Image& img, int row_begin, int row_end) const {
+  TESSERA_CHECK(img.width() == width() && img.height() == height() && row_begin >= 0 && row_end <= height());
+  for (int y = window_.y0 + row_begin; y < window_.y0 + row_end; ++y)
+    for (int x = window_.x0; x < window_.x1; ++x) img.set_rgb(x - window_.x0, y - window_.y0, mean({x, y}));
 }
 
 Image Film::variance_image() const {

@@ -118,6 +118,9 @@ class Film {
   std::vector<float> to_rgb() const;
   /// Mean radiance as a 3-channel linear image of the window.
   Image to_image() const;
+  /// Rows [row_begin, row_end) of to_image() (counted from the window's top) into `img`, which has
+  /// the window's size: a large film converted a band at a time.
+  void to_image_rows(Image& img, int row_begin, int row_end) const;
   /// Per-pixel variance of the mean (sample variance / count), 3 channels: a noise estimate.
   Image variance_image() const;
 

@@ -32,7 +32,7 @@ struct CoordinatorOptions {
   // Group commit (group_commit.h): under load, a state-database commit starts at most this often
   // (seconds), taking every lease, result and phase change decided meanwhile: fewer fsyncs per
   // unit for at most this much more latency. 0: commit as soon as the previous commit ends.
-  double commit_interval = 0.002;
+  double commit_interval = 0.004;
   int max_waiting_polls = 16;     // concurrent long polls; more get 204 at once (never starve clients)
   // Idle workers get a copy of a job's oldest outstanding unit once it has no unleased one
   // (scheduler.h); the first result wins and a later one must match it bit for bit.

@@ -94,6 +94,8 @@ class Store {
   void log_lease(uint64_t seq, uint64_t job, uint32_t tile, uint32_t pass, uint64_t worker, double now);
   /// The largest lease id ever logged (also once its rows were deleted).
   uint64_t last_lease_seq();
+  /// The highest worker id registered so far (0 if none).
+  uint64_t last_worker_id();
   /// Commits an acknowledged result. False if (job, tile, pass) already had one (a duplicate).
   bool add_result(uint64_t job, uint32_t tile, uint32_t pass, uint64_t worker, const std::string& data,
                   double now);
