@@ -164,7 +164,7 @@ TEST(GroupCommit, UnderLoadACommitWaitsUpToAnotherIntervalForAsManyRecordsAsTheL
   using namespace std::chrono_literals;
   TempDb db;
   Store store(db.path());
-  GroupCommit commits(store, {}, 300ms);
+  GroupCommit commits(store, {}, 500ms);
   // A batch of five (appended while the writer was held): the writer is under load.
   Blocker blocker;
   (void)blocker.append(commits);
@@ -175,10 +175,10 @@ TEST(GroupCommit, UnderLoadACommitWaitsUpToAnotherIntervalForAsManyRecordsAsTheL
   const auto batch_start = std::chrono::steady_clock::now();  // (about when that batch started)
   // Four come back at once and the fifth late, after the interval but within two: one commit.
   for (uint64_t seq = 6; seq <= 9; ++seq) last = commits.append(lease_record(seq));
-  std::this_thread::sleep_until(batch_start + 420ms);
+  std::this_thread::sleep_until(batch_start + 700ms);
   const uint64_t late = commits.append(lease_record(10));
   commits.wait(last);
-  EXPECT_GE(std::chrono::steady_clock::now() - batch_start, 400ms) << "the first four did not wait for the fifth";
+  EXPECT_GE(std::chrono::steady_clock::now() - batch_start, 680ms) << "the first four did not wait for the fifth";
   commits.wait(late);
   EXPECT_EQ(commits.stats().commits, 3u);
   EXPECT_EQ(store.leases_issued(1), 10u);
