@@ -31,6 +31,41 @@ struct Vertex {
   const Medium* medium = nullptr;  // medium around the vertex (on a surface: resolved per light side)
 };
 
+// The dimensions of one bounce, drawn in one fixed layout whether used or not (see sampler.h), so
+// that a pixel's later bounces see the same dimensions whatever happened before.
+struct BounceSamples {
+  float u_pick;   // light selection
+  Vec2 u_light;   // a point on the light
+  float u_lobe;   // the BSDF's lobe (unused by phase functions)
+  Vec2 u_dir;     // the scattered direction
+  float u_rr;     // Russian roulette
+  static BounceSamples draw(Sampler& sampler) {
+    BounceSamples b;
+    b.u_pick = sampler.next_1d();
+    b.u_light = sampler.next_2d();
+    b.u_lobe = sampler.next_1d();
+    b.u_dir = sampler.next_2d();
+    b.u_rr = sampler.next_1d();
+    return b;
+  }
+};
+
+// A path under construction: the radiance gathered so far and what the next step needs.
+struct PathState {
+  Ray ray;
+  Rgb L, throughput{1.f};
+  float eta = 1.f;  // product of the relative IORs crossed by refraction (BsdfSample::eta)
+  int depth = 0;  // scattering events so far
+  int null_crossings = 0;
+  float prev_pdf = 0.f;
+  bool prev_delta = true;  // the camera "vertex" has no BSDF to combine with
+  LightSampleContext prev_ctx;  // the previous vertex, for the light-selection pmf in MIS
+  const Medium* medium = nullptr;
+};
+
+// What a segment through a medium did to the path.
+enum class MediumEvent { PassedThrough, Scattered, Ended };
+
 class PathIntegrator final : public Integrator {
  public:
   PathIntegrator(const IntegratorSettings& s, bool volumetric) : s_(s), volumetric_(volumetric) {}
@@ -39,135 +74,137 @@ class PathIntegrator final : public Integrator {
          RenderCounters& counters) const override {
     if (s_.max_depth == 0) return {};
     const bool media = volumetric_ && scene.has_media();
-    const Medium* medium = media ? scene.camera_medium : nullptr;
-    Rgb L, throughput(1.f);
-    float eta = 1.f;  // product of the relative IORs crossed by refraction (BsdfSample::eta)
-    Ray ray = camera_ray;
-    int depth = 0;  // scattering events so far
-    int null_crossings = 0;
-    float prev_pdf = 0.f;
-    bool prev_delta = true;  // the camera "vertex" has no BSDF to combine with
-    LightSampleContext prev_ctx;  // the previous vertex, for the light-selection pmf in MIS
+    PathState path;
+    path.medium = media ? scene.camera_medium : nullptr;
+    path.ray = camera_ray;
     SurfaceInteraction si;
-
     for (;;) {
-      ray.time = camera_ray.time;  // every ray of a path sees the scene at the camera ray's time
-      const bool visible_emitters = depth > 0 || !s_.hide_emitters;
+      path.ray.time = camera_ray.time;  // every ray of a path sees the scene at the camera ray's time
       // Media take two more dimensions per segment (sampler.h); scenes without media keep the layout.
       const Vec2 u_medium = media ? sampler.next_2d() : Vec2();
-      const bool found = scene.intersect(ray, si, media);
-
-      if (medium) {
-        MediumSample ms;
-        medium->sample(ray, found ? si.t : kInfinity, u_medium, ms);
-        throughput *= ms.weight;
-        if (throughput.is_black()) break;
-        if (ms.scattered) {
-          if (s_.max_depth >= 0 && depth + 1 >= s_.max_depth) break;
-          Vertex v;
-          v.p = ray.at(ms.t);
-          v.wo = -normalize(ray.d);
-          v.phase = &medium->phase();
-          v.medium = medium;
-          v.time = ray.time;
-          const float u_pick = sampler.next_1d();
-          const Vec2 u_light = sampler.next_2d();
-          (void)sampler.next_1d();  // the lobe dimension, unused by phase functions
-          const Vec2 u_dir = sampler.next_2d();
-          const float u_rr = sampler.next_1d();
-          L += throughput * sample_direct(scene, v, u_pick, u_light, counters);
-          Vec3 wi;
-          float pdf = 0.f;
-          const float weight = v.phase->sample(v.wo, u_dir, wi, pdf);
-          if (!(weight > 0.f) || !(pdf > 0.f)) break;
-          throughput *= weight;
-          prev_pdf = pdf;
-          prev_delta = false;
-          prev_ctx = {v.p, Vec3(0.f)};
-          ++depth;
-          null_crossings = 0;
-          if (!survives_roulette(depth, throughput, eta, u_rr)) break;
-          ray = Ray{v.p, wi};
-          ++counters.bounce_rays;
-          continue;
-        }
+      const bool found = scene.intersect(path.ray, si, media);
+      if (path.medium) {
+        const MediumEvent event = medium_step(scene, path, found ? si.t : kInfinity, u_medium, sampler, counters);
+        if (event == MediumEvent::Ended) break;
+        if (event == MediumEvent::Scattered) continue;
       }
-
       if (!found) {
-        if (visible_emitters) {
-          for (const Light* env : scene.infinite_lights()) {
-            Rgb le = env->le_env(ray.d);
-            if (le.is_black()) continue;
-            float w = prev_delta ? 1.f : hit_weight(prev_pdf, [&] { return env->pdf_env(ray.d) * scene.light_pmf(prev_ctx, env); });
-            if (w > 0.f || s_.strategy == SamplingStrategy::Mis) L += throughput * le * w;
-          }
-        }
+        add_environment(scene, path);
         break;
       }
-
-      const Bsdf* bsdf = si.bsdf();
-      if (media && bsdf && bsdf->is_null()) {
-        // An index-matched boundary: only the medium changes; the path vertex stays where it was.
-        if (++null_crossings > kMaxNullCrossings) break;
-        medium = medium_after(si, ray.d, medium);
-        ray = spawn_ray(si, ray.d);
-        continue;
-      }
-      null_crossings = 0;
-
-      const Vec3 wo_world = -ray.d;
-      if (const Light* area = si.area_light(); area && visible_emitters) {
-        Rgb le = area->le(si, wo_world);
-        if (!le.is_black()) {
-          float w = prev_delta ? 1.f
-                               : hit_weight(prev_pdf, [&] { return area->pdf_li(prev_ctx.p, si) * scene.light_pmf(prev_ctx, area); });
-          if (w > 0.f || s_.strategy == SamplingStrategy::Mis) L += throughput * le * w;
-        }
-      }
-
-      if (s_.max_depth >= 0 && depth + 1 >= s_.max_depth) break;
-      if (!reconcile_shading_frame(si, wo_world, s_.strict_normals)) break;
-      if (!bsdf) break;
-      const Vec3 wo = si.to_local(wo_world);
-
-      // Fixed dimension layout per bounce (see sampler.h), drawn whether used or not.
-      const float u_pick = sampler.next_1d();
-      const Vec2 u_light = sampler.next_2d();
-      const float u_lobe = sampler.next_1d();
-      const Vec2 u_bsdf = sampler.next_2d();
-      const float u_rr = sampler.next_1d();
-
-      if (!bsdf->is_delta()) {
-        Vertex v;
-        v.si = &si;
-        v.bsdf = bsdf;
-        v.wo = wo;
-        v.p = si.p;
-        v.ng = si.ng;
-        v.medium = medium;
-        v.time = ray.time;
-        L += throughput * sample_direct(scene, v, u_pick, u_light, counters);
-      }
-
-      BsdfSample bs;
-      if (!bsdf->sample(si, wo, u_lobe, u_bsdf, bs)) break;
-      const Vec3 wi_world = si.to_world(bs.wi);
-      if (!consistent_side(si, wi_world, bs.wi)) break;
-      throughput *= bs.weight;
-      prev_pdf = bs.pdf;
-      prev_delta = bs.delta;
-      eta *= bs.eta;
-      prev_ctx = {si.p, si.shading.n};
-      ++depth;
-      if (media) medium = medium_after(si, wi_world, medium);
-      if (!survives_roulette(depth, throughput, eta, u_rr)) break;
-      ray = spawn_ray(si, wi_world);
-      ++counters.bounce_rays;
+      if (!surface_step(scene, path, si, media, sampler, counters)) break;
     }
-    return L;
+    return path.L;
   }
 
  private:
+  bool visible_emitters(const PathState& path) const { return path.depth > 0 || !s_.hide_emitters; }
+
+  // The free flight through the path's medium up to `t_max` (the next surface); at a scattering
+  // point, next-event estimation with the phase function and the phase-sampled next segment.
+  MediumEvent medium_step(const Scene& scene, PathState& path, float t_max, Vec2 u_medium, Sampler& sampler,
+                          RenderCounters& counters) const {
+    MediumSample ms;
+    path.medium->sample(path.ray, t_max, u_medium, ms);
+    path.throughput *= ms.weight;
+    if (path.throughput.is_black()) return MediumEvent::Ended;
+    if (!ms.scattered) return MediumEvent::PassedThrough;
+    if (s_.max_depth >= 0 && path.depth + 1 >= s_.max_depth) return MediumEvent::Ended;
+    Vertex v;
+    v.p = path.ray.at(ms.t);
+    v.wo = -normalize(path.ray.d);
+    v.phase = &path.medium->phase();
+    v.medium = path.medium;
+    v.time = path.ray.time;
+    const BounceSamples u = BounceSamples::draw(sampler);
+    path.L += path.throughput * sample_direct(scene, v, u.u_pick, u.u_light, counters);
+    Vec3 wi;
+    float pdf = 0.f;
+    const float weight = v.phase->sample(v.wo, u.u_dir, wi, pdf);
+    if (!(weight > 0.f) || !(pdf > 0.f)) return MediumEvent::Ended;
+    path.throughput *= weight;
+    path.prev_pdf = pdf;
+    path.prev_delta = false;
+    path.prev_ctx = {v.p, Vec3(0.f)};
+    ++path.depth;
+    path.null_crossings = 0;
+    if (!survives_roulette(path.depth, path.throughput, path.eta, u.u_rr)) return MediumEvent::Ended;
+    path.ray = Ray{v.p, wi};
+    ++counters.bounce_rays;
+    return MediumEvent::Scattered;
+  }
+
+  // A ray that left the scene: the environment's radiance, MIS-weighted against the previous vertex.
+  void add_environment(const Scene& scene, PathState& path) const {
+    if (!visible_emitters(path)) return;
+    for (const Light* env : scene.infinite_lights()) {
+      Rgb le = env->le_env(path.ray.d);
+      if (le.is_black()) continue;
+      float w = path.prev_delta ? 1.f : hit_weight(path.prev_pdf, [&] {
+        return env->pdf_env(path.ray.d) * scene.light_pmf(path.prev_ctx, env);
+      });
+      if (w > 0.f || s_.strategy == SamplingStrategy::Mis) path.L += path.throughput * le * w;
+    }
+  }
+
+  // A surface hit: an index-matched boundary only switches the medium; otherwise its emission
+  // (MIS-weighted), next-event estimation and the BSDF-sampled next segment. False ends the path.
+  bool surface_step(const Scene& scene, PathState& path, SurfaceInteraction& si, bool media, Sampler& sampler,
+                    RenderCounters& counters) const {
+    const Bsdf* bsdf = si.bsdf();
+    if (media && bsdf && bsdf->is_null()) {
+      // The path vertex stays where it was.
+      if (++path.null_crossings > kMaxNullCrossings) return false;
+      path.medium = medium_after(si, path.ray.d, path.medium);
+      path.ray = spawn_ray(si, path.ray.d);
+      return true;
+    }
+    path.null_crossings = 0;
+    const Vec3 wo_world = -path.ray.d;
+    if (const Light* area = si.area_light(); area && visible_emitters(path)) add_emission(scene, path, si, *area);
+    if (s_.max_depth >= 0 && path.depth + 1 >= s_.max_depth) return false;
+    if (!reconcile_shading_frame(si, wo_world, s_.strict_normals)) return false;
+    if (!bsdf) return false;
+    const Vec3 wo = si.to_local(wo_world);
+    const BounceSamples u = BounceSamples::draw(sampler);
+    if (!bsdf->is_delta()) {
+      Vertex v;
+      v.si = &si;
+      v.bsdf = bsdf;
+      v.wo = wo;
+      v.p = si.p;
+      v.ng = si.ng;
+      v.medium = path.medium;
+      v.time = path.ray.time;
+      path.L += path.throughput * sample_direct(scene, v, u.u_pick, u.u_light, counters);
+    }
+    BsdfSample bs;
+    if (!bsdf->sample(si, wo, u.u_lobe, u.u_dir, bs)) return false;
+    const Vec3 wi_world = si.to_world(bs.wi);
+    if (!consistent_side(si, wi_world, bs.wi)) return false;
+    path.throughput *= bs.weight;
+    path.prev_pdf = bs.pdf;
+    path.prev_delta = bs.delta;
+    path.eta *= bs.eta;
+    path.prev_ctx = {si.p, si.shading.n};
+    ++path.depth;
+    if (media) path.medium = medium_after(si, wi_world, path.medium);
+    if (!survives_roulette(path.depth, path.throughput, path.eta, u.u_rr)) return false;
+    path.ray = spawn_ray(si, wi_world);
+    ++counters.bounce_rays;
+    return true;
+  }
+
+  // An emitter hit by the path, MIS-weighted against the previous vertex's light sampling.
+  void add_emission(const Scene& scene, PathState& path, const SurfaceInteraction& si, const Light& area) const {
+    Rgb le = area.le(si, -path.ray.d);
+    if (le.is_black()) return;
+    float w = path.prev_delta ? 1.f : hit_weight(path.prev_pdf, [&] {
+      return area.pdf_li(path.prev_ctx.p, si) * scene.light_pmf(path.prev_ctx, &area);
+    });
+    if (w > 0.f || s_.strategy == SamplingStrategy::Mis) path.L += path.throughput * le * w;
+  }
+
   // Russian roulette as Mitsuba 3: survival probability from the throughput, times eta^2 so that
   // refraction's radiance scaling does not kill paths inside glass early; capped at 0.95.
   bool survives_roulette(int depth, Rgb& throughput, float eta, float u_rr) const {
