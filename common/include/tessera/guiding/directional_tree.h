@@ -1,0 +1,87 @@
+// A learned distribution of directions for path guiding, after the directional quadtree ("D-tree")
+// of Müller et al. 2017, "Practical Path Guiding for Efficient Light-Transport Simulation".
+//
+// Directions live on the unit square through the equal-area map of square_to_uniform_sphere
+// (x = (1 - cos theta) / 2, y = phi / 2 pi, about world +z), so a density over the square is the
+// solid-angle density times 4 pi. The square is cut into a quadtree; each node holds the energy
+// recorded in its four quadrants, and a direction is drawn by descending in proportion to them.
+//
+// Exact, order-free statistics: a record is quantised to 64-bit fixed point (rounded up or down by
+// a dither the caller draws from the sample's own random numbers, so the rounding is unbiased and
+// deterministic) and added atomically to its leaf. Integer sums do not depend on the order of the
+// records, so training statistics are the same bits for any thread count, tile size, or order in
+// which a farm's tiles arrive, and two trees of one structure merge exactly (merge()).
+//
+// Life cycle per training iteration: record() into the building tree from many threads; build()
+// once (sums up the quadrants of inner nodes); the built tree then samples (sample(), pdf()) for
+// the next iteration, whose building tree is refined(): the same directions, cut finer where the
+// energy is, with zero sums.
+#pragma once
+
+#include "tessera/core/vec.h"
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace tessera {
+
+/// Equal-area map of a unit direction onto [0,1)^2 (the inverse of square_to_uniform_sphere).
+Vec2 direction_to_square(Vec3 dir);
+
+class DirectionalTree {
+ public:
+  /// Nodes deeper than this are never made (a leaf then is 4^-20 of the sphere).
+  static constexpr int kMaxDepth = 20;
+  /// Fixed-point resolution: a record's value times 2^kScaleBits is what is added.
+  static constexpr int kScaleBits = 16;
+  /// A larger record is clamped to this (keeps sums of millions of records within 64 bits).
+  static constexpr float kMaxRecord = float(1 << 24);
+
+  /// One node: the whole sphere in four leaf quadrants.
+  DirectionalTree();
+
+  /// Adds `value` (>= 0; others are ignored) at `dir`. `dither` in [0,1) decides the rounding.
+  /// Thread-safe against other record() calls; not against build() or merge().
+  void record(Vec3 dir, float value, float dither);
+  /// Adds the sums of a tree of the same structure (the same refined() ancestry).
+  void merge(const DirectionalTree& other);
+  /// Makes the inner quadrants' sums the totals of their subtrees. Before sampling.
+  void build();
+
+  /// Draws a direction; `pdf` is its solid-angle density (a tree without energy is uniform).
+  Vec3 sample(Vec2 u, float& pdf) const;
+  /// Solid-angle density of sample() at `dir`.
+  float pdf(Vec3 dir) const;
+
+  /// The next iteration's tree (of a built tree): a quadrant whose share of the total energy is
+  /// above `threshold` is split (to at most kMaxDepth), a subtree whose share is not is merged;
+  /// sums are zero. A leaf's energy counts as spread evenly over the quadrants it is split into.
+  DirectionalTree refined(double threshold) const;
+
+  /// The same cells with zero sums (for when a refined tree would not fit the memory cap).
+  DirectionalTree cleared() const;
+
+  /// All energy recorded (after build()), in fixed-point units.
+  uint64_t total() const;
+  size_t node_count() const { return nodes_.size(); }
+  size_t bytes() const { return sizeof(*this) + nodes_.size() * sizeof(Node); }
+  int depth() const;
+  /// The sums and structure compare equal.
+  bool operator==(const DirectionalTree& other) const;
+
+ private:
+  struct Node {
+    std::array<uint32_t, 4> child{};  // 0: the quadrant is a leaf
+    std::array<uint64_t, 4> sum{};
+  };
+  // Quadrant i covers x in [i&1 ? 0.5 : 0, ...) and y in [i&2 ? 0.5 : 0, ...) of its node.
+  static int quadrant(Vec2& p);
+  uint64_t build_node(uint32_t n);
+  void refine_into(DirectionalTree& out, uint32_t out_node, const Node* node, double scale, int depth,
+                   double threshold) const;
+
+  std::vector<Node> nodes_;
+};
+
+}  // namespace tessera

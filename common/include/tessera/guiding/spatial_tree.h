@@ -1,0 +1,73 @@
+// The spatial half of path guiding's SD-tree (Müller et al. 2017): a binary tree over the scene's
+// bounds, cut at midpoints along x, y, z in turn, whose leaves each hold a directional tree
+// (directional_tree.h) of the radiance arriving in that region: the one learned in the previous
+// training iteration (sampled from) and the one being recorded.
+//
+// Deterministic: records are exact integer sums (see directional_tree.h) and a sample count per
+// leaf, and end_iteration() decides every split from them in leaf order, so the trees are the
+// same bits for any order of the records. Memory is capped: no leaf is split once the tree would
+// exceed GuidingSettings::max_bytes.
+#pragma once
+
+#include "tessera/core/bounds.h"
+#include "tessera/guiding/directional_tree.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace tessera {
+
+struct GuidingSettings {
+  /// A leaf is split once its samples in an iteration exceed this times sqrt(2^iteration)
+  /// (Müller's sTreeThreshold).
+  double spatial_threshold = 12000.0;
+  /// A direction quadrant is split when its share of its leaf's energy exceeds this (dTreeThreshold).
+  double directional_threshold = 0.01;
+  /// Cap on the memory of the whole tree.
+  size_t max_bytes = size_t(256) << 20;
+};
+
+class SpatialTree {
+ public:
+  /// One leaf over `bounds`, made a cube about its centre (so cuts halve its longest side first).
+  explicit SpatialTree(const Bounds3& bounds);
+
+  /// The leaf whose region holds `p` (a point outside the bounds goes to the nearest region).
+  uint32_t leaf_of(Vec3 p) const;
+  /// The leaf's distribution learned in the previous iteration (uniform before the first).
+  const DirectionalTree& sampling(uint32_t leaf) const { return leaves_[leaf].sampling; }
+  /// Records radiance `value` arriving from `dir` in the leaf (see DirectionalTree::record) and
+  /// counts the sample, also when `value` is 0. Thread-safe against other record() calls.
+  void record(uint32_t leaf, Vec3 dir, float value, float dither);
+
+  /// Ends training iteration `iteration` (0, 1, ...): splits the leaves that saw enough samples
+  /// (within the memory cap), then makes each leaf's recorded tree its sampling tree and starts a
+  /// refined one for the next iteration. Not thread-safe: at a pass barrier.
+  void end_iteration(int iteration, const GuidingSettings& settings);
+
+  size_t leaf_count() const { return leaves_.size(); }
+  size_t node_count() const { return nodes_.size(); }
+  /// The tree's memory (nodes, leaves and their directional trees).
+  size_t bytes() const;
+  bool operator==(const SpatialTree& other) const;
+
+ private:
+  static constexpr uint32_t kNoLeaf = ~uint32_t(0);
+  struct Node {
+    uint32_t child[2] = {0, 0};  // (below `lo`/above the midpoint along axis = depth % 3)
+    uint32_t leaf = kNoLeaf;
+  };
+  struct Leaf {
+    DirectionalTree sampling, building;
+    uint64_t samples = 0;
+  };
+  void split(uint32_t node);
+  static size_t leaf_bytes(const Leaf& leaf);
+
+  Bounds3 bounds_;
+  std::vector<Node> nodes_;
+  std::vector<Leaf> leaves_;
+};
+
+}  // namespace tessera

@@ -1,0 +1,105 @@
+#include "tessera/guiding/spatial_tree.h"
+
+#include "tessera/core/check.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+
+namespace tessera {
+
+SpatialTree::SpatialTree(const Bounds3& bounds) : nodes_(1), leaves_(1) {
+  TESSERA_CHECK(!bounds.empty());
+  const Vec3 d = bounds.diagonal();
+  const float half = 0.5f * std::max({d.x, d.y, d.z, 1e-6f});
+  const Vec3 c = bounds.center();
+  bounds_.lo = c - Vec3(half);
+  bounds_.hi = c + Vec3(half);
+  nodes_[0].leaf = 0;
+}
+
+uint32_t SpatialTree::leaf_of(Vec3 p) const {
+  // Position within the cube in [0,1]^3; each level doubles the coordinate it cuts.
+  const Vec3 size = bounds_.diagonal();
+  Vec3 u((p.x - bounds_.lo.x) / size.x, (p.y - bounds_.lo.y) / size.y, (p.z - bounds_.lo.z) / size.z);
+  float c[3] = {std::clamp(u.x, 0.f, 1.f), std::clamp(u.y, 0.f, 1.f), std::clamp(u.z, 0.f, 1.f)};
+  if (!(c[0] == c[0]) || !(c[1] == c[1]) || !(c[2] == c[2])) c[0] = c[1] = c[2] = 0.5f;  // (NaN)
+  uint32_t n = 0;
+  for (int depth = 0; nodes_[n].leaf == kNoLeaf; ++depth) {
+    float& x = c[depth % 3];
+    const bool upper = x >= 0.5f;
+    x = upper ? 2.f * x - 1.f : 2.f * x;
+    n = nodes_[n].child[upper ? 1 : 0];
+  }
+  return nodes_[n].leaf;
+}
+
+void SpatialTree::record(uint32_t leaf, Vec3 dir, float value, float dither) {
+  Leaf& l = leaves_[leaf];
+  std::atomic_ref<uint64_t>(l.samples).fetch_add(1, std::memory_order_relaxed);
+  l.building.record(dir, value, dither);
+}
+
+size_t SpatialTree::leaf_bytes(const Leaf& leaf) {
+  return sizeof(Leaf) - 2 * sizeof(DirectionalTree) + leaf.sampling.bytes() + leaf.building.bytes();
+}
+
+size_t SpatialTree::bytes() const {
+  size_t total = sizeof(*this) + nodes_.size() * sizeof(Node);
+  for (const Leaf& l : leaves_) total += leaf_bytes(l);
+  return total;
+}
+
+void SpatialTree::split(uint32_t node) {
+  // Both halves start from the parent's trees (the same directions, half the samples each).
+  const uint32_t leaf = nodes_[node].leaf, other = uint32_t(leaves_.size());
+  leaves_[leaf].samples /= 2;
+  leaves_.push_back(leaves_[leaf]);
+  const uint32_t lo = uint32_t(nodes_.size());
+  nodes_.resize(nodes_.size() + 2);
+  nodes_[lo].leaf = leaf;
+  nodes_[lo + 1].leaf = other;
+  nodes_[node].leaf = kNoLeaf;
+  nodes_[node].child[0] = lo;
+  nodes_[node].child[1] = lo + 1;
+}
+
+void SpatialTree::end_iteration(int iteration, const GuidingSettings& settings) {
+  const double threshold = settings.spatial_threshold * std::sqrt(std::ldexp(1.0, std::min(iteration, 60)));
+  size_t total = bytes();
+  // In index order, children right after they are made: a half that still has too many samples
+  // is split again. The order, and so the result, depends only on the counts.
+  for (uint32_t n = 0; n < nodes_.size(); ++n) {
+    const uint32_t leaf = nodes_[n].leaf;
+    if (leaf == kNoLeaf || !(double(leaves_[leaf].samples) > threshold)) continue;
+    const size_t cost = 2 * sizeof(Node) + leaf_bytes(leaves_[leaf]);
+    if (total + cost > settings.max_bytes) continue;
+    split(n);
+    total += cost;
+  }
+  for (Leaf& l : leaves_) {
+    const size_t before = leaf_bytes(l);
+    l.building.build();
+    l.sampling = std::move(l.building);
+    l.building = l.sampling.refined(settings.directional_threshold);
+    // A refined tree that would not fit keeps the cells it has.
+    if (total - before + leaf_bytes(l) > settings.max_bytes) l.building = l.sampling.cleared();
+    total = total - before + leaf_bytes(l);
+    l.samples = 0;
+  }
+}
+
+bool SpatialTree::operator==(const SpatialTree& other) const {
+  if (nodes_.size() != other.nodes_.size() || leaves_.size() != other.leaves_.size()) return false;
+  for (size_t n = 0; n < nodes_.size(); ++n)
+    if (nodes_[n].leaf != other.nodes_[n].leaf || nodes_[n].child[0] != other.nodes_[n].child[0] ||
+        nodes_[n].child[1] != other.nodes_[n].child[1])
+      return false;
+  for (size_t l = 0; l < leaves_.size(); ++l)
+    if (leaves_[l].samples != other.leaves_[l].samples || !(leaves_[l].sampling == other.leaves_[l].sampling) ||
+        !(leaves_[l].building == other.leaves_[l].building))
+      return false;
+  return true;
+}
+
+}  // namespace tessera

@@ -1,0 +1,115 @@
+// The spatial tree of path guiding (guiding/spatial_tree.h): splits decided by sample counts and
+// the iteration, within the memory cap, the same bits for any order of records, and every point
+// (also outside the bounds, or NaN) finds a leaf.
+#include "tessera/guiding/spatial_tree.h"
+
+#include "tessera/core/hash.h"
+#include "tessera/core/sampling.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <thread>
+#include <vector>
+
+namespace tessera {
+namespace {
+
+Bounds3 unit_box() {
+  Bounds3 b;
+  b.extend(Vec3(0.f));
+  b.extend(Vec3(1.f));
+  return b;
+}
+
+void record_at(SpatialTree& tree, Vec3 p, int n, uint64_t seed) {
+  Pcg32 rng(seed);
+  const uint32_t leaf = tree.leaf_of(p);
+  for (int k = 0; k < n; ++k)
+    tree.record(leaf, square_to_uniform_sphere(Vec2(rng.next_float(), rng.next_float())), rng.next_float() * 10.f,
+                rng.next_float());
+}
+
+TEST(SpatialTree, ALeafIsSplitWhileItsHalvesStillHaveTooManySamples) {
+  GuidingSettings s;
+  s.spatial_threshold = 400;
+  SpatialTree first(unit_box());
+  record_at(first, Vec3(0.1f), 1000, 1);
+  first.end_iteration(0, s);  // 1000 > 400, halves of 500 > 400, quarters of 250 are not
+  EXPECT_EQ(first.leaf_count(), 4u);
+  EXPECT_EQ(first.node_count(), 7u);
+  SpatialTree later(unit_box());
+  record_at(later, Vec3(0.1f), 1000, 1);
+  later.end_iteration(2, s);  // the threshold grows with sqrt(2^iteration): 800
+  EXPECT_EQ(later.leaf_count(), 2u);
+  // The one cut is along x at the middle.
+  EXPECT_NE(later.leaf_of(Vec3(0.2f, 0.2f, 0.2f)), later.leaf_of(Vec3(0.7f, 0.2f, 0.2f)));
+  EXPECT_EQ(later.leaf_of(Vec3(0.2f, 0.2f, 0.2f)), later.leaf_of(Vec3(0.2f, 0.9f, 0.9f)));
+}
+
+TEST(SpatialTree, PointsFindTheLeafOfTheirRegion) {
+  GuidingSettings s;
+  s.spatial_threshold = 100;
+  SpatialTree tree(unit_box());
+  record_at(tree, Vec3(0.05f), 2000, 2);
+  tree.end_iteration(0, s);
+  ASSERT_GT(tree.leaf_count(), 4u);
+  // The first cut is x at 0.5, then y, then z; points on one side of every cut share a leaf.
+  EXPECT_NE(tree.leaf_of(Vec3(0.2f, 0.2f, 0.2f)), tree.leaf_of(Vec3(0.7f, 0.2f, 0.2f)));
+  EXPECT_NE(tree.leaf_of(Vec3(0.2f, 0.2f, 0.2f)), tree.leaf_of(Vec3(0.2f, 0.7f, 0.2f)));
+  EXPECT_EQ(tree.leaf_of(Vec3(0.01f, 0.01f, 0.01f)), tree.leaf_of(Vec3(0.02f, 0.02f, 0.02f)));
+  // Outside the bounds: the nearest region; NaN: some leaf, never out of range.
+  EXPECT_EQ(tree.leaf_of(Vec3(-5.f, -5.f, -5.f)), tree.leaf_of(Vec3(0.f)));
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_LT(tree.leaf_of(Vec3(nan, 0.f, 0.f)), tree.leaf_count());
+  EXPECT_LT(tree.leaf_of(Vec3(std::numeric_limits<float>::infinity())), tree.leaf_count());
+}
+
+TEST(SpatialTree, TheSameRecordsInAnyOrderGiveTheSameTree) {
+  GuidingSettings s;
+  s.spatial_threshold = 200;
+  std::vector<Vec3> points;
+  Pcg32 rng(4);
+  for (int k = 0; k < 40; ++k) points.emplace_back(rng.next_float(), rng.next_float() * 0.3f, rng.next_float());
+  SpatialTree serial(unit_box()), threaded(unit_box());
+  for (int it = 0; it < 3; ++it) {
+    for (size_t k = 0; k < points.size(); ++k) record_at(serial, points[k], 100, 10 * it + k);
+    std::vector<std::thread> threads;
+    for (size_t t = 0; t < 2; ++t)
+      threads.emplace_back([&, t] {
+        for (size_t k = points.size() - 1 - t; k < points.size(); k -= 2) record_at(threaded, points[k], 100, 10 * it + k);
+      });
+    for (std::thread& t : threads) t.join();
+    serial.end_iteration(it, s);
+    threaded.end_iteration(it, s);
+    ASSERT_TRUE(serial == threaded) << "iteration " << it;
+  }
+  EXPECT_GT(serial.leaf_count(), 8u);
+}
+
+TEST(SpatialTree, NothingIsSplitBeyondTheMemoryCap) {
+  GuidingSettings s;
+  s.spatial_threshold = 10;
+  s.max_bytes = SpatialTree(unit_box()).bytes() + 100;  // too small for a split
+  SpatialTree tree(unit_box());
+  for (int it = 0; it < 3; ++it) {
+    record_at(tree, Vec3(0.3f), 5000, 5 + it);
+    tree.end_iteration(it, s);
+  }
+  EXPECT_EQ(tree.leaf_count(), 1u);
+  EXPECT_LE(tree.bytes(), s.max_bytes);
+  // It still guides, with the directions it could afford.
+  float pdf = 0.f;
+  const Vec3 d = tree.sampling(0).sample(Vec2(0.3f, 0.6f), pdf);
+  EXPECT_TRUE(pdf > 0.f && std::isfinite(pdf));
+  EXPECT_NEAR(length(d), 1.f, 1e-5f);
+  // A larger cap lets it split.
+  s.max_bytes = size_t(256) << 20;
+  record_at(tree, Vec3(0.3f), 5000, 9);
+  tree.end_iteration(3, s);
+  EXPECT_GT(tree.leaf_count(), 1u);
+}
+
+}  // namespace
+}  // namespace tessera
