@@ -1,0 +1,25 @@
+// Path guiding's choice of the next direction: one-sample MIS of the BSDF's own sampling and a
+// learned distribution of incident radiance (guiding/directional_tree.h, in world space). With
+// probability `bsdf_fraction` the BSDF samples, otherwise the guide; the pdf is the mixture's,
+//   pdf(wi) = bsdf_fraction * bsdf.pdf(wi) + (1 - bsdf_fraction) * guide.pdf(wi)   (solid angle),
+// and the weight eval(wi) / pdf(wi) (eval includes the cosine, bsdf.h). A delta lobe the BSDF picks
+// is outside the mixture: its pdf and weight are the BSDF's, for the probability of choosing the
+// BSDF. The lobe dimension `u_lobe` also makes the choice (rescaled for the BSDF), so guiding
+// draws no dimension the unguided path does not (sampler.h). Hot path: no throw, no allocation.
+#pragma once
+
+#include "tessera/guiding/directional_tree.h"
+#include "tessera/render/bsdf.h"
+
+namespace tessera {
+
+/// Samples `out` (wi in the local frame of `si`) from the mixture; false when nothing was sampled.
+/// The weight is black for a guided direction where the BSDF is zero. A guided direction's `eta`
+/// is 1 (only Russian roulette reads it).
+bool sample_guided(const Bsdf& bsdf, const SurfaceInteraction& si, Vec3 wo, const DirectionalTree& guide,
+                   float bsdf_fraction, float u_lobe, Vec2 u_dir, BsdfSample& out);
+/// The mixture's solid-angle density of the non-delta direction `wi` (local frame).
+float guided_pdf(const Bsdf& bsdf, const SurfaceInteraction& si, Vec3 wo, Vec3 wi, const DirectionalTree& guide,
+                 float bsdf_fraction);
+
+}  // namespace tessera

@@ -1,0 +1,35 @@
+#include "tessera/render/guided_sampling.h"
+
+#include <algorithm>
+
+namespace tessera {
+
+float guided_pdf(const Bsdf& bsdf, const SurfaceInteraction& si, Vec3 wo, Vec3 wi, const DirectionalTree& guide,
+                 float bsdf_fraction) {
+  return bsdf_fraction * bsdf.pdf(si, wo, wi) + (1.f - bsdf_fraction) * guide.pdf(si.to_world(wi));
+}
+
+bool sample_guided(const Bsdf& bsdf, const SurfaceInteraction& si, Vec3 wo, const DirectionalTree& guide,
+                   float bsdf_fraction, float u_lobe, Vec2 u_dir, BsdfSample& out) {
+  if (u_lobe < bsdf_fraction) {
+    // (u_lobe / bsdf_fraction is uniform in [0,1) again: the BSDF's own lobe choice.)
+    const float u = std::min(u_lobe / bsdf_fraction, 1.f - 0x1p-24f);
+    if (!bsdf.sample(si, wo, u, u_dir, out)) return false;
+    if (out.delta) {
+      out.pdf *= bsdf_fraction;
+      out.weight *= 1.f / bsdf_fraction;
+      return true;
+    }
+  } else {
+    float guide_pdf = 0.f;
+    out.wi = si.to_local(guide.sample(u_dir, guide_pdf));
+    out.eta = 1.f;
+    out.delta = false;
+  }
+  out.pdf = guided_pdf(bsdf, si, wo, out.wi, guide, bsdf_fraction);
+  if (!(out.pdf > 0.f)) return false;
+  out.weight = bsdf.eval(si, wo, out.wi) * (1.f / out.pdf);  // (black where the BSDF has nothing)
+  return true;
+}
+
+}  // namespace tessera
