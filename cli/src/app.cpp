@@ -35,6 +35,10 @@ int main_entry(int argc, char** argv) {
   r->add_option("--target-error", render.target_error,
                 "Stop at a pass whose estimated relMSE is at most this (--spp is then the budget)")
       ->check(CLI::Range(0.0, 1.0));
+  r->add_option("--guiding", render.guiding,
+                "Path guiding (path/volpath): the first half of the samples trains a guide, the rest use it "
+                "(default off)")
+      ->check(CLI::IsMember({"on", "off"}))->capture_default_str();
   r->add_option("--width", render.width, "Film width (default: the scene's)")->check(CLI::PositiveNumber);
   r->add_option("--height", render.height, "Film height (default: the scene's)")->check(CLI::PositiveNumber);
   r->add_option("--threads", render.threads, "Render threads (default: all cores)")->check(CLI::NonNegativeNumber);

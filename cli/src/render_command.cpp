@@ -125,6 +125,7 @@ int run_render(const RenderOptions& options) {
     settings.threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
     settings.tile_size = options.tile_size;
     settings.target_error = options.target_error;
+    settings.guiding = options.guiding == "on";
 
     const std::vector<uint32_t> passes = pass_schedule(uint32_t(settings.spp));
     Progress progress("render", !options.quiet);

@@ -8,6 +8,8 @@
 #include "tessera/render/film.h"
 #include "tessera/render/renderer.h"
 #include "tessera/render/scene.h"
+#include "tessera/scene/load_context.h"
+#include "tessera/scene/scene_desc.h"
 
 #include <cmath>
 #include <memory>
@@ -77,6 +79,44 @@ inline std::optional<const Shape*> cover(const Scene& scene, int x, int y) {
     first = s;
   }
   return first;
+}
+
+/// An open box (floor, back and left walls) under a dim sky, with every kind of light path the
+/// path tracer's strategies treat differently: area lights of two sizes, a point light, a constant
+/// sky, a perfect mirror, smooth plastic (a delta coat over a diffuse base), a rough conductor.
+inline const char* kMixedScene = R"(<scene version="3.0.0">
+  <integrator type="path"><integer name="max_depth" value="6"/></integrator>
+  <sensor type="perspective"><float name="fov" value="55"/>
+    <transform name="to_world"><lookat origin="0,1.2,4.5" target="0,0.6,0" up="0,1,0"/></transform>
+    <sampler type="independent"><integer name="sample_count" value="4"/></sampler>
+    <film type="hdrfilm"><integer name="width" value="32"/><integer name="height" value="24"/>
+      <rfilter type="box"/></film>
+  </sensor>
+  <bsdf type="diffuse" id="grey"><rgb name="reflectance" value="0.6"/></bsdf>
+  <shape type="rectangle"><transform name="to_world"><scale value="3"/><rotate x="1" angle="-90"/></transform>
+    <ref id="grey"/></shape>
+  <shape type="rectangle"><transform name="to_world"><scale value="3"/><translate z="-2"/></transform>
+    <ref id="grey"/></shape>
+  <shape type="rectangle"><transform name="to_world"><scale value="3"/><rotate y="1" angle="90"/>
+    <translate x="-2"/></transform><bsdf type="diffuse"><rgb name="reflectance" value="0.7,0.2,0.2"/></bsdf></shape>
+  <shape type="sphere"><point name="center" x="-0.9" y="0.5" z="0"/><float name="radius" value="0.5"/>
+    <bsdf type="conductor"/></shape>
+  <shape type="sphere"><point name="center" x="0.4" y="0.45" z="0.4"/><float name="radius" value="0.45"/>
+    <bsdf type="plastic"><rgb name="diffuse_reflectance" value="0.2,0.3,0.7"/></bsdf></shape>
+  <shape type="sphere"><point name="center" x="1.3" y="0.4" z="-0.8"/><float name="radius" value="0.4"/>
+    <bsdf type="roughconductor"><float name="alpha" value="0.15"/></bsdf></shape>
+  <shape type="sphere"><point name="center" x="0.8" y="2.2" z="-0.5"/><float name="radius" value="0.25"/>
+    <emitter type="area"><rgb name="radiance" value="12,10,8"/></emitter></shape>
+  <shape type="rectangle"><transform name="to_world"><scale value="0.5"/><rotate x="1" angle="90"/>
+    <translate x="-0.8" y="2.5" z="0.2"/></transform>
+    <emitter type="area"><rgb name="radiance" value="4,4,5"/></emitter></shape>
+  <emitter type="point"><point name="position" x="-1.2" y="1.8" z="1.5"/><rgb name="intensity" value="3"/></emitter>
+  <emitter type="constant"><rgb name="radiance" value="0.3,0.35,0.4"/></emitter>
+</scene>)";
+
+inline std::unique_ptr<Scene> mixed_scene() {
+  LoadResult r = load_scene(parse_scene_string(kMixedScene, "mixed_scene.xml"), LoadOptions{});
+  return std::move(r.scene);
 }
 
 }  // namespace tessera::test

@@ -13,7 +13,8 @@ class DirectIntegrator final : public Integrator {
  public:
   explicit DirectIntegrator(const IntegratorSettings& s) : s_(s) {}
 
-  Rgb li(const Scene& scene, const Ray& ray, Sampler& sampler, RenderCounters& counters) const override {
+  Rgb li(const Scene& scene, const Ray& ray, Sampler& sampler, RenderCounters& counters,
+         const PathGuide* /*guide*/) const override {
     Rgb L;
     SurfaceInteraction si;
     if (!scene.intersect(ray, si)) {

@@ -9,6 +9,7 @@
 // factor for both strategies that can reach a light, so the MIS weights use the directional pdfs.
 #include "tessera/core/frame.h"
 #include "tessera/core/sampling.h"
+#include "tessera/render/guided_sampling.h"
 #include "tessera/render/integrator.h"
 
 #include <algorithm>
@@ -29,6 +30,8 @@ struct Vertex {
   Vec3 p, ng;  // ng is zero in a medium: no ray offset, no side test
   float time = 0.f;  // the path's time (motion blur): shadow rays see the scene at that instant
   const Medium* medium = nullptr;  // medium around the vertex (on a surface: resolved per light side)
+  const DirectionalTree* guide = nullptr;  // a guided surface vertex: its scattering pdf is the mixture's
+  float bsdf_fraction = 1.f;
 };
 
 // The dimensions of one bounce, drawn in one fixed layout whether used or not (see sampler.h), so
@@ -61,6 +64,8 @@ struct PathState {
   bool prev_delta = true;  // the camera "vertex" has no BSDF to combine with
   LightSampleContext prev_ctx;  // the previous vertex, for the light-selection pmf in MIS
   const Medium* medium = nullptr;
+  const PathGuide* guide = nullptr;  // path guiding, if this pass guides or trains
+  GuideRecords* records = nullptr;   // where a training pass keeps the path's vertices
 };
 
 // What a segment through a medium did to the path.
@@ -70,13 +75,16 @@ class PathIntegrator final : public Integrator {
  public:
   PathIntegrator(const IntegratorSettings& s, bool volumetric) : s_(s), volumetric_(volumetric) {}
 
-  Rgb li(const Scene& scene, const Ray& camera_ray, Sampler& sampler,
-         RenderCounters& counters) const override {
+  Rgb li(const Scene& scene, const Ray& camera_ray, Sampler& sampler, RenderCounters& counters,
+         const PathGuide* guide) const override {
     if (s_.max_depth == 0) return {};
     const bool media = volumetric_ && scene.has_media();
     PathState path;
     path.medium = media ? scene.camera_medium : nullptr;
     path.ray = camera_ray;
+    path.guide = guide;
+    GuideRecords records;
+    if (guide && guide->train) path.records = &records;
     SurfaceInteraction si;
     for (;;) {
       path.ray.time = camera_ray.time;  // every ray of a path sees the scene at the camera ray's time
@@ -94,6 +102,7 @@ class PathIntegrator final : public Integrator {
       }
       if (!surface_step(scene, path, si, media, sampler, counters)) break;
     }
+    if (path.records) path.records->commit(*guide->train, path.L, sampler);
     return path.L;
   }
 
@@ -167,6 +176,10 @@ class PathIntegrator final : public Integrator {
     if (!bsdf) return false;
     const Vec3 wo = si.to_local(wo_world);
     const BounceSamples u = BounceSamples::draw(sampler);
+    // Guided where a direction is sampled at all (not at delta-only BSDFs).
+    const bool guided = path.guide && !bsdf->is_delta();
+    const uint32_t leaf = guided ? (path.guide->sample_from ? *path.guide->sample_from : *path.guide->train).leaf_of(si.p) : 0;
+    const DirectionalTree* guide = guided && path.guide->sample_from ? &path.guide->sample_from->sampling(leaf) : nullptr;
     if (!bsdf->is_delta()) {
       Vertex v;
       v.si = &si;
@@ -176,13 +189,18 @@ class PathIntegrator final : public Integrator {
       v.ng = si.ng;
       v.medium = path.medium;
       v.time = path.ray.time;
+      v.guide = guide;
+      v.bsdf_fraction = guide ? path.guide->bsdf_fraction : 1.f;
       path.L += path.throughput * sample_direct(scene, v, u.u_pick, u.u_light, counters);
     }
     BsdfSample bs;
-    if (!bsdf->sample(si, wo, u.u_lobe, u.u_dir, bs)) return false;
+    if (guide ? !sample_guided(*bsdf, si, wo, *guide, path.guide->bsdf_fraction, u.u_lobe, u.u_dir, bs)
+              : !bsdf->sample(si, wo, u.u_lobe, u.u_dir, bs))
+      return false;
     const Vec3 wi_world = si.to_world(bs.wi);
     if (!consistent_side(si, wi_world, bs.wi)) return false;
     path.throughput *= bs.weight;
+    if (path.records && !bs.delta) path.records->add(leaf, wi_world, bs.pdf, path.throughput, path.L);
     path.prev_pdf = bs.pdf;
     path.prev_delta = bs.delta;
     path.eta *= bs.eta;
@@ -249,7 +267,8 @@ class PathIntegrator final : public Integrator {
       const Vec3 wi = v.si->to_local(ls.wi);
       if (!consistent_side(*v.si, ls.wi, wi)) return {};
       f = v.bsdf->eval(*v.si, v.wo, wi);
-      if (!ls.delta && mis) scatter_pdf = v.bsdf->pdf(*v.si, v.wo, wi);
+      if (!ls.delta && mis)
+        scatter_pdf = v.guide ? guided_pdf(*v.bsdf, *v.si, v.wo, wi, *v.guide, v.bsdf_fraction) : v.bsdf->pdf(*v.si, v.wo, wi);
       if (volumetric_) shadow_medium = medium_after(*v.si, ls.wi, v.medium);
     } else {
       f = Rgb(v.phase->eval(v.wo, ls.wi));

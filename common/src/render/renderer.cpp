@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <chrono>
 #include <mutex>
+#include <optional>
 
 namespace tessera {
 
@@ -27,6 +28,12 @@ std::vector<uint32_t> pass_schedule(uint32_t spp) {
   return passes;
 }
 
+bool guiding_trains_pass(const std::vector<uint32_t>& passes, size_t pass, uint32_t spp) {
+  uint32_t end = 0;
+  for (size_t p = 0; p <= pass && p < passes.size(); ++p) end += passes[p];
+  return pass < passes.size() && end <= spp / 2;
+}
+
 std::vector<TileRect> make_tiles(const TileRect& window, int tile_size) {
   TESSERA_CHECK(tile_size > 0);
   std::vector<TileRect> tiles;
@@ -40,7 +47,7 @@ namespace {
 
 void render_tile_with(const Scene& scene, const Integrator& integrator, const Filter* filter,
                       const TileRect& rect, uint32_t sample_begin, uint32_t sample_end, uint32_t seed,
-                      FilmTile& tile) {
+                      const PathGuide* guide, FilmTile& tile) {
   TESSERA_CHECK(scene.camera != nullptr);
   tile.reset(rect);
   Sampler sampler(scene.sampler.type, seed);
@@ -60,7 +67,7 @@ void render_tile_with(const Scene& scene, const Integrator& integrator, const Fi
         const float time = timed ? open + shutter * sampler.sample_1d_at(Sampler::kTimeDimension) : open;
         Ray ray = scene.camera->generate_ray_at(raster, u_lens, time);
         ++tile.counters.camera_rays;
-        Rgb L = integrator.li(scene, ray, sampler, tile.counters);
+        Rgb L = integrator.li(scene, ray, sampler, tile.counters, guide);
         tile.add_sample({x, y}, L);
       }
     }
@@ -72,7 +79,7 @@ void render_tile_with(const Scene& scene, const Integrator& integrator, const Fi
 void render_tile(const Scene& scene, const TileRect& rect, uint32_t sample_begin, uint32_t sample_end,
                  uint32_t seed, FilmTile& tile) {
   auto integrator = make_integrator(scene.integrator);
-  render_tile_with(scene, *integrator, scene.film.filter.get(), rect, sample_begin, sample_end, seed, tile);
+  render_tile_with(scene, *integrator, scene.film.filter.get(), rect, sample_begin, sample_end, seed, nullptr, tile);
 }
 
 Film render(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress,
@@ -92,6 +99,10 @@ Film render(const Scene& scene, const RenderSettings& settings, const ProgressCa
   std::mutex mutex;  // guards counters and progress; taken once per tile
   RenderCounters counters;
   double noise = 0;
+  std::optional<SpatialTree> tree;
+  if (settings.guiding && scene.integrator.type != IntegratorType::Direct && !scene.bounds().empty())
+    tree.emplace(scene.bounds());
+  size_t trained = 0;  // training passes so far
 
   tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
   arena.execute([&] {
@@ -99,12 +110,18 @@ Film render(const Scene& scene, const RenderSettings& settings, const ProgressCa
     for (size_t p = 0; p < passes.size(); ++p) {
       const uint32_t end = begin + passes[p];
       prog.pass = int(p);
+      PathGuide guide;
+      if (tree) {
+        guide.sample_from = trained > 0 ? &*tree : nullptr;
+        guide.train = guiding_trains_pass(passes, p, uint32_t(settings.spp)) ? &*tree : nullptr;
+      }
+      const PathGuide* pass_guide = guide.sample_from || guide.train ? &guide : nullptr;
       // Tiles are disjoint, so adding their sums concurrently touches distinct pixels; passes are
       // separated by the parallel_for barrier, which fixes the per-pixel order of pass sums.
       tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
         FilmTile tile;
         for (size_t i = r.begin(); i != r.end(); ++i) {
-          render_tile_with(scene, *integrator, filter, tiles[i], begin, end, settings.seed, tile);
+          render_tile_with(scene, *integrator, filter, tiles[i], begin, end, settings.seed, pass_guide, tile);
           film.add_tile(tile);
           std::lock_guard<std::mutex> lock(mutex);
           counters += tile.counters;
@@ -112,6 +129,7 @@ Film render(const Scene& scene, const RenderSettings& settings, const ProgressCa
           if (progress) progress(prog);
         }
       });
+      if (guide.train) tree->end_iteration(int(trained++), settings.guiding_settings);  // (at the barrier)
       begin = end;
       prog.samples_done = end;
       if (settings.target_error > 0 && p + 1 < passes.size()) {

@@ -30,6 +30,7 @@
 #include "tessera/core/ray.h"
 #include "tessera/core/rgb.h"
 #include "tessera/render/film.h"
+#include "tessera/render/path_guide.h"
 #include "tessera/render/sampler.h"
 #include "tessera/render/scene.h"
 
@@ -42,8 +43,10 @@ class Integrator {
  public:
   virtual ~Integrator() = default;
   /// Radiance arriving at the camera along `ray`. Adds the rays it traces (bounce and shadow rays,
-  /// not the camera ray itself) to `counters`.
-  virtual Rgb li(const Scene& scene, const Ray& ray, Sampler& sampler, RenderCounters& counters) const = 0;
+  /// not the camera ray itself) to `counters`. `guide`: path guiding for this pass (path_guide.h),
+  /// or null; integrators that do not guide ignore it.
+  virtual Rgb li(const Scene& scene, const Ray& ray, Sampler& sampler, RenderCounters& counters,
+                 const PathGuide* guide) const = 0;
 };
 
 std::unique_ptr<Integrator> make_path_integrator(const IntegratorSettings& settings);

@@ -8,6 +8,7 @@
 // the same bits for any thread count or tile size.
 #pragma once
 
+#include "tessera/guiding/spatial_tree.h"
 #include "tessera/render/film.h"
 #include "tessera/render/scene.h"
 
@@ -26,6 +27,12 @@ struct RenderSettings {
   /// is at most this; spp is then the budget. Decided on whole passes only, so the image equals
   /// a render with the spp reached (and a farm job with the same target).
   double target_error = 0;
+  /// Path guiding (path/volpath only): the passes that end within the first half of the samples
+  /// train an SD-tree (guiding_trains_pass), each later pass samples with what the previous
+  /// training passes learned. Every sample counts in the image with weight 1, so it converges to
+  /// the unguided image; the learned trees are the same bits for any thread count or tile size.
+  bool guiding = false;
+  GuidingSettings guiding_settings;
 };
 
 struct RenderStats {
@@ -48,6 +55,9 @@ using ProgressCallback = std::function<void(const RenderProgress&)>;
 /// so a preview (and the farm's first results) arrive quickly; capped so passes stay balanced.
 std::vector<uint32_t> pass_schedule(uint32_t spp);
 
+/// Whether pass `pass` of `passes` (for `spp` samples) trains the guide of a guided render: those
+/// that end within the first half of the samples (none with fewer than 2 samples per pixel).
+bool guiding_trains_pass(const std::vector<uint32_t>& passes, size_t pass, uint32_t spp);
 /// Tiles of `window`, row-major, `tile_size` square (smaller at the right and bottom edges).
 std::vector<TileRect> make_tiles(const TileRect& window, int tile_size);
 

@@ -1,0 +1,57 @@
+// The path tracer's side of path guiding (guiding/spatial_tree.h): what one render pass asks of
+// the integrator, and the radiance a path brings back to the vertices where it chose a direction.
+//
+// Training record (Müller et al. 2017): at a vertex where the path sampled direction wi with
+// (mixture) pdf p, the radiance arriving along wi is what the rest of the path added to the
+// camera's estimate, over the path's throughput after that vertex: Li = dL / T. The guide records
+// luminance(Li) / p, an estimate of the incident radiance integrated over the leaf's cells, at wi.
+// Its rounding dither comes from a dedicated sampler dimension per vertex (sampler.h), so the
+// statistics are a function of (pixel, sample index, seed) like every sample value.
+#pragma once
+
+#include "tessera/core/rgb.h"
+#include "tessera/core/vec.h"
+#include "tessera/guiding/spatial_tree.h"
+
+#include <array>
+#include <cstdint>
+
+namespace tessera {
+
+class Sampler;
+
+/// What a pass asks of the path tracer; a null member switches that part off.
+struct PathGuide {
+  const SpatialTree* sample_from = nullptr;  // guide directions with its learned distributions
+  SpatialTree* train = nullptr;              // record the pass's radiance into it
+  float bsdf_fraction = 0.5f;                // probability of sampling the BSDF, not the guide
+};
+
+/// The vertices of one path that sampled a direction to record, and at the path's end the
+/// radiance each received. Fixed capacity (no allocation): deeper vertices are not recorded.
+class GuideRecords {
+ public:
+  static constexpr int kCapacity = 32;
+  /// Dimensions of the dither of vertex k: kDitherDimension + k (far from the sequential ones).
+  static constexpr uint32_t kDitherDimension = 0xFFFFFE00u;
+
+  /// A vertex in `leaf` sampled `wi` (world) with density `pdf`; `throughput` is the path's after
+  /// the vertex's weight (before Russian roulette), `radiance` the camera's estimate so far.
+  void add(uint32_t leaf, Vec3 wi, float pdf, const Rgb& throughput, const Rgb& radiance) {
+    if (count_ < kCapacity) vertices_[size_t(count_++)] = {leaf, wi, pdf, throughput, radiance};
+  }
+  /// Records every vertex into `tree` once the path's estimate is `radiance`.
+  void commit(SpatialTree& tree, const Rgb& radiance, Sampler& sampler) const;
+
+ private:
+  struct Vertex {
+    uint32_t leaf;
+    Vec3 wi;
+    float pdf;
+    Rgb throughput, radiance;
+  };
+  std::array<Vertex, kCapacity> vertices_;
+  int count_ = 0;
+};
+
+}  // namespace tessera
