@@ -48,6 +48,14 @@ DirectionalTree trained(int iterations, size_t per_iteration) {
   return tree;
 }
 
+test::Chi2Result tree_chi2(const DirectionalTree& tree, const test::Chi2Options& o) {
+  return test::chi2_test([&](Vec2 u) {
+    float pdf = 0.f;
+    const Vec3 d = tree.sample(u, pdf);
+    return test::Chi2Sample{d, pdf};
+  }, [&](Vec3 w) { return double(tree.pdf(w)); }, o);
+}
+
 TEST(DirectionalTree, SquareMapIsTheInverseOfTheSphereMap) {
   Pcg32 rng(3);
   for (int k = 0; k < 10000; ++k) {
@@ -68,11 +76,7 @@ TEST(DirectionalTree, AnEmptyTreeIsUniform) {
   test::Chi2Options o;
   o.name = "empty directional tree";
   o.sample_count = 200000;
-  auto r = test::chi2_test([&](Vec2 u) {
-    float pdf = 0.f;
-    const Vec3 d = tree.sample(u, pdf);
-    return test::Chi2Sample{d, pdf};
-  }, [&](Vec3 w) { return double(tree.pdf(w)); }, o);
+  const test::Chi2Result r = tree_chi2(tree, o);
   EXPECT_TRUE(r.passed) << r.message;
 }
 
@@ -86,11 +90,7 @@ TEST(DirectionalTree, SamplesFollowThePdfOfATrainedTree) {
   o.phi_bins = 256;
   o.integration_resolution = 16;
   o.sample_count = 2000000;
-  auto r = test::chi2_test([&](Vec2 u) {
-    float pdf = 0.f;
-    const Vec3 d = tree.sample(u, pdf);
-    return test::Chi2Sample{d, pdf};
-  }, [&](Vec3 w) { return double(tree.pdf(w)); }, o);
+  const test::Chi2Result r = tree_chi2(tree, o);
   EXPECT_TRUE(r.passed) << r.message;
   EXPECT_NEAR(r.pdf_integral, 1.0, 1e-2);
 }
