@@ -77,6 +77,8 @@ int main_entry(int argc, char** argv) {
   bc->add_option("--spp", conv.spp, "Budgets, e.g. 1,2,4,8 (default 1..64 doubling)")->delimiter(',');
   bc->add_option("--seconds", conv.seconds, "Then keep doubling spp until one render takes this long")
       ->check(CLI::NonNegativeNumber);
+  bc->add_option("--guiding", conv.guiding, "Path guiding, e.g. off,on: each strategy with each (default off); "
+                 "guided series are named STRATEGY+guiding")->delimiter(',')->check(CLI::IsMember({"off", "on"}));
   bc->add_option("--strategy", conv.strategies, "Sampling strategies: mis, bsdf, nee (default mis)")->delimiter(',')
       ->check(CLI::IsMember({"mis", "bsdf", "nee"}));
   bc->add_option("--csv", conv.csv, "Write the measurements here");

@@ -43,15 +43,22 @@ void print_time_to_target(const std::string& strategy, const std::vector<Converg
 }  // namespace
 
 int run_bench_convergence(const ConvergenceOptions& options) {
+  // A series: a strategy, with or without guiding, named "mis" or "mis+guiding".
   std::vector<SamplingStrategy> strategies;
-  std::vector<std::string> names = options.strategies.empty() ? std::vector<std::string>{"mis"} : options.strategies;
-  for (const auto& name : names) {
+  std::vector<bool> guided;
+  std::vector<std::string> names;
+  const std::vector<std::string> guiding = options.guiding.empty() ? std::vector<std::string>{"off"} : options.guiding;
+  for (const auto& name : options.strategies.empty() ? std::vector<std::string>{"mis"} : options.strategies) {
     SamplingStrategy s;
     if (!parse_sampling_strategy(name, s)) {
       std::fprintf(stderr, "tessera bench convergence: unknown strategy '%s' (use mis, bsdf, nee)\n", name.c_str());
       return 2;
     }
-    strategies.push_back(s);
+    for (const auto& g : guiding) {
+      strategies.push_back(s);
+      guided.push_back(g == "on");
+      names.push_back(g == "on" ? name + "+guiding" : name);
+    }
   }
   std::vector<int> budgets = options.spp;
   if (budgets.empty() && options.seconds <= 0) budgets = {1, 2, 4, 8, 16, 32, 64};
@@ -91,6 +98,7 @@ int run_bench_convergence(const ConvergenceOptions& options) {
     std::vector<ConvergencePoint> all;
     for (size_t si = 0; si < strategies.size(); ++si) {
       scene.integrator.strategy = strategies[si];
+      settings.guiding = guided[si];
       std::vector<ConvergencePoint> mine;
       auto run_budget = [&](size_t index, int spp) {
         settings.spp = spp;

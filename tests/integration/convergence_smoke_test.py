@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
 """CI smoke run of bench/convergence.sh (docs/performance.md): cornell-box at its reference's
-256x256, spp 1 and 2, every strategy, into a temporary folder. Expected: the script exits 0; the CSV
-has the header and exactly the rows bsdf/nee/mis x 1/2 spp in that order, with finite positive
+256x256, spp 1 and 2, every strategy with and without path guiding, into a temporary folder.
+Expected: the script exits 0; the CSV has the header and exactly the rows bsdf/nee/mis (each plain,
+then +guiding) x 1/2 spp in that order, with finite positive
 relMSE and times, a mean ratio within [0.5, 2] and a noise estimate that is infinite at 1 spp (no
 variance from one sample) and finite at 2; the SVG parses as XML with two panels' polylines per
-strategy. Missing scene/reference files: exit 77 (skip) locally, failure under CI=true."""
+series. Missing scene/reference files: exit 77 (skip) locally, failure under CI=true."""
 import argparse
 import csv
 import math
@@ -41,7 +42,7 @@ def main():
 
     with tempfile.TemporaryDirectory() as out:
         env = dict(os.environ, TESSERA=args.cli, CONV_SCENES=SCENE, CONV_SPP="1,2", CONV_OUT=out,
-                   CONV_STRATEGIES="bsdf,nee,mis", CONV_THREADS="2")
+                   CONV_STRATEGIES="bsdf,nee,mis", CONV_GUIDING="off,on", CONV_THREADS="2")
         r = subprocess.run(["bash", os.path.join(args.source, "bench", "convergence.sh"), "unused", "0"],
                            env=env, capture_output=True, text=True, timeout=300)
         print(r.stdout)
@@ -55,7 +56,7 @@ def main():
         if rows[0] != header:
             fail("CSV header %r" % rows[0])
         got = [(row[0], int(row[1])) for row in rows[1:]]
-        want = [(s, n) for s in ("bsdf", "nee", "mis") for n in (1, 2)]
+        want = [(s + g, n) for s in ("bsdf", "nee", "mis") for g in ("", "+guiding") for n in (1, 2)]
         if got != want:
             fail("CSV rows %r, expected %r" % (got, want))
         for row in rows[1:]:
@@ -75,14 +76,14 @@ def main():
         if root.tag != "{http://www.w3.org/2000/svg}svg":
             fail("SVG root is %r" % root.tag)
         lines = root.findall(".//{http://www.w3.org/2000/svg}polyline")
-        if len(lines) != 6:
-            fail("%d polylines in the SVG, expected 6" % len(lines))
+        if len(lines) != 12:
+            fail("%d polylines in the SVG, expected 12" % len(lines))
         for line in lines:
             if len(line.get("points", "").split()) != 2:
                 fail("a polyline without its two points: %r" % line.get("points"))
         txt = open(os.path.join(out, SCENE + ".txt")).read()
-        if txt.count("time_to_target") != 6:
-            fail("expected 6 time_to_target lines in the output")
+        if txt.count("time_to_target") != 12:
+            fail("expected 12 time_to_target lines in the output (2 targets x 6 series)")
     print("ok")
 
 

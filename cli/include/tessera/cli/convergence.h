@@ -22,6 +22,7 @@ struct ConvergenceOptions {
   /// (capped at 65536 spp), so each strategy spends about twice this in total.
   double seconds = 0;
   std::vector<std::string> strategies;  // "mis", "bsdf", "nee"; empty: mis
+  std::vector<std::string> guiding;     // "off", "on" (each strategy with each); empty: off
   std::string csv, plot;                // output paths; empty: not written
   int width = 0, height = 0;            // > 0: film size (the reference must match it)
   int threads = 0;                      // 0: all cores
