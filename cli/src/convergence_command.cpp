@@ -44,9 +44,12 @@ void print_time_to_target(const std::string& strategy, const std::vector<Converg
 
 int run_bench_convergence(const ConvergenceOptions& options) {
   // A series: a strategy, with or without guiding, named "mis" or "mis+guiding".
-  std::vector<SamplingStrategy> strategies;
-  std::vector<bool> guided;
-  std::vector<std::string> names;
+  struct Series {
+    std::string name;
+    SamplingStrategy strategy;
+    bool guiding;
+  };
+  std::vector<Series> series;
   const std::vector<std::string> guiding = options.guiding.empty() ? std::vector<std::string>{"off"} : options.guiding;
   for (const auto& name : options.strategies.empty() ? std::vector<std::string>{"mis"} : options.strategies) {
     SamplingStrategy s;
@@ -54,11 +57,7 @@ int run_bench_convergence(const ConvergenceOptions& options) {
       std::fprintf(stderr, "tessera bench convergence: unknown strategy '%s' (use mis, bsdf, nee)\n", name.c_str());
       return 2;
     }
-    for (const auto& g : guiding) {
-      strategies.push_back(s);
-      guided.push_back(g == "on");
-      names.push_back(g == "on" ? name + "+guiding" : name);
-    }
+    for (const auto& g : guiding) series.push_back({g == "on" ? name + "+guiding" : name, s, g == "on"});
   }
   std::vector<int> budgets = options.spp;
   if (budgets.empty() && options.seconds <= 0) budgets = {1, 2, 4, 8, 16, 32, 64};
@@ -96,9 +95,9 @@ int run_bench_convergence(const ConvergenceOptions& options) {
 
     std::printf("convergence scene=%s %dx%d threads=%d\n", options.scene.c_str(), w, h, settings.threads);
     std::vector<ConvergencePoint> all;
-    for (size_t si = 0; si < strategies.size(); ++si) {
-      scene.integrator.strategy = strategies[si];
-      settings.guiding = guided[si];
+    for (const Series& one : series) {
+      scene.integrator.strategy = one.strategy;
+      settings.guiding = one.guiding;
       std::vector<ConvergencePoint> mine;
       auto run_budget = [&](size_t index, int spp) {
         settings.spp = spp;
@@ -106,7 +105,7 @@ int run_bench_convergence(const ConvergenceOptions& options) {
         RenderStats stats;
         Film film = render(scene, settings, {}, &stats);
         ConvergencePoint p;
-        p.strategy = names[si];
+        p.strategy = one.name;
         p.spp = spp;
         p.seconds = stats.seconds;
         p.error = measure_error(film.to_image().to_rgb(), ref);
@@ -126,7 +125,7 @@ int run_bench_convergence(const ConvergenceOptions& options) {
           spp *= 2;
         }
       }
-      for (double target : {1e-2, 1e-3}) print_time_to_target(names[si], mine, target);
+      for (double target : {1e-2, 1e-3}) print_time_to_target(one.name, mine, target);
       all.insert(all.end(), mine.begin(), mine.end());
     }
 

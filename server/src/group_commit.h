@@ -40,7 +40,8 @@ class GroupCommit {
   /// arrived while it committed), a commit starts at least this long after the previous one
   /// started, and records arriving meanwhile join it; it waits up to one more interval for as many
   /// records as the previous batch held. Fewer and larger commits for a latency of at most two
-  /// intervals. Otherwise (an idle writer, or one client at a time) a record is committed at once. `max_batch`: records per transaction at most (bounds a batch's latency and WAL growth).
+  /// intervals. Otherwise (an idle writer, or one client at a time) a record is committed at once.
+  /// `max_batch`: records per transaction at most (bounds a batch's latency and WAL growth).
   explicit GroupCommit(Store& store, Runner runner = {}, std::chrono::microseconds min_interval = {},
                        size_t max_batch = 256);
   /// Commits what is queued, then stops the writer.

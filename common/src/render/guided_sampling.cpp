@@ -21,7 +21,8 @@ bool sample_guided(const Bsdf& bsdf, const SurfaceInteraction& si, Vec3 wo, cons
       return true;
     }
   } else {
-    float guide_pdf = 0.f;
+    float guide_pdf = 0.f;  // (not used: the mixture's pdf is evaluated for the direction as it
+                            // lies after rounding, as next-event estimation's MIS evaluates it)
     out.wi = si.to_local(guide.sample(u_dir, guide_pdf));
     out.eta = 1.f;
     out.delta = false;

@@ -102,7 +102,7 @@ class PathIntegrator final : public Integrator {
       }
       if (!surface_step(scene, path, si, media, sampler, counters)) break;
     }
-    if (path.records) path.records->commit(*guide->train, path.L, sampler);
+    if (path.records) path.records->commit(*guide->tree, path.L, sampler);
     return path.L;
   }
 
@@ -178,8 +178,8 @@ class PathIntegrator final : public Integrator {
     const BounceSamples u = BounceSamples::draw(sampler);
     // Guided where a direction is sampled at all (not at delta-only BSDFs).
     const bool guided = path.guide && !bsdf->is_delta();
-    const uint32_t leaf = guided ? (path.guide->sample_from ? *path.guide->sample_from : *path.guide->train).leaf_of(si.p) : 0;
-    const DirectionalTree* guide = guided && path.guide->sample_from ? &path.guide->sample_from->sampling(leaf) : nullptr;
+    const uint32_t leaf = guided ? path.guide->tree->leaf_of(si.p) : 0;
+    const DirectionalTree* guide = guided && path.guide->sample ? &path.guide->tree->sampling(leaf) : nullptr;
     if (!bsdf->is_delta()) {
       Vertex v;
       v.si = &si;

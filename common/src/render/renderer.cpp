@@ -74,15 +74,6 @@ void render_tile_with(const Scene& scene, const Integrator& integrator, const Fi
   }
 }
 
-// A pass samples with what earlier passes learned, and trains if it is one of the training passes.
-PathGuide guide_for_pass(SpatialTree* tree, bool learned, bool trains) {
-  PathGuide guide;
-  if (!tree) return guide;
-  guide.sample_from = learned ? tree : nullptr;
-  guide.train = trains ? tree : nullptr;
-  return guide;
-}
-
 }  // namespace
 
 void render_tile(const Scene& scene, const TileRect& rect, uint32_t sample_begin, uint32_t sample_end,
@@ -119,9 +110,9 @@ Film render(const Scene& scene, const RenderSettings& settings, const ProgressCa
     for (size_t p = 0; p < passes.size(); ++p) {
       const uint32_t end = begin + passes[p];
       prog.pass = int(p);
-      const PathGuide guide = guide_for_pass(tree ? &*tree : nullptr, trained > 0,
-                                             guiding_trains_pass(passes, p, uint32_t(settings.spp)));
-      const PathGuide* pass_guide = guide.sample_from || guide.train ? &guide : nullptr;
+      // A pass samples with what earlier passes learned, and trains if it is a training pass.
+      PathGuide guide{tree ? &*tree : nullptr, trained > 0, guiding_trains_pass(passes, p, uint32_t(settings.spp))};
+      const PathGuide* pass_guide = guide.tree && (guide.sample || guide.train) ? &guide : nullptr;
       // Tiles are disjoint, so adding their sums concurrently touches distinct pixels; passes are
       // separated by the parallel_for barrier, which fixes the per-pixel order of pass sums.
       tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
@@ -135,7 +126,7 @@ Film render(const Scene& scene, const RenderSettings& settings, const ProgressCa
           if (progress) progress(prog);
         }
       });
-      if (guide.train) tree->end_iteration(int(trained++), settings.guiding_settings);  // (at the barrier)
+      if (pass_guide && guide.train) tree->end_iteration(int(trained++), settings.guiding_settings);  // (at the barrier)
       begin = end;
       prog.samples_done = end;
       if (settings.target_error > 0 && p + 1 < passes.size()) {

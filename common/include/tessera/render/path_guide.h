@@ -20,11 +20,12 @@ namespace tessera {
 
 class Sampler;
 
-/// What a pass asks of the path tracer; a null member switches that part off.
+/// What a pass asks of the path tracer (null: no guiding at all).
 struct PathGuide {
-  const SpatialTree* sample_from = nullptr;  // guide directions with its learned distributions
-  SpatialTree* train = nullptr;              // record the pass's radiance into it
-  float bsdf_fraction = 0.5f;                // probability of sampling the BSDF, not the guide
+  SpatialTree* tree = nullptr;
+  bool sample = false;        // guide directions with the tree's learned distributions
+  bool train = false;         // record the pass's radiance into the tree
+  float bsdf_fraction = 0.5f; // probability of sampling the BSDF, not the guide
 };
 
 /// The vertices of one path that sampled a direction to record, and at the path's end the
