@@ -8,8 +8,9 @@
 
 namespace tessera {
 
-SpatialTree::SpatialTree(const Bounds3& bounds) : nodes_(1), leaves_(1) {
-  TESSERA_CHECK(!bounds.empty());
+SpatialTree::SpatialTree(const Bounds3& bounds, float bsdf_fraction) : nodes_(1), leaves_(1) {
+  TESSERA_CHECK(!bounds.empty() && bsdf_fraction >= 0.f && bsdf_fraction <= 1.f);
+  leaves_[0].bsdf_fraction = bsdf_fraction;
   const Vec3 d = bounds.diagonal();
   const float half = 0.5f * std::max({d.x, d.y, d.z, 1e-6f});
   const Vec3 c = bounds.center();
@@ -86,6 +87,8 @@ void SpatialTree::end_iteration(int iteration, const GuidingSettings& settings) 
     if (total - before + leaf_bytes(l) > settings.max_bytes) l.building = l.sampling.cleared();
     total = total - before + leaf_bytes(l);
     l.samples = 0;
+    if (settings.learn_bsdf_fraction) l.bsdf_fraction = l.fraction_loss.best(l.bsdf_fraction);
+    l.fraction_loss = {};
   }
 }
 
@@ -97,7 +100,8 @@ bool SpatialTree::operator==(const SpatialTree& other) const {
       return false;
   for (size_t l = 0; l < leaves_.size(); ++l)
     if (leaves_[l].samples != other.leaves_[l].samples || !(leaves_[l].sampling == other.leaves_[l].sampling) ||
-        !(leaves_[l].building == other.leaves_[l].building))
+        !(leaves_[l].building == other.leaves_[l].building) || leaves_[l].bsdf_fraction != other.leaves_[l].bsdf_fraction ||
+        !(leaves_[l].fraction_loss == other.leaves_[l].fraction_loss))
       return false;
   return true;
 }

@@ -4,13 +4,25 @@
 
 namespace tessera {
 
+namespace {
+
+MixturePdfs mixture_pdfs(const Bsdf& bsdf, const SurfaceInteraction& si, Vec3 wo, Vec3 wi, const DirectionalTree& guide) {
+  return {bsdf.pdf(si, wo, wi), guide.pdf(si.to_world(wi))};
+}
+
+float mix(const MixturePdfs& p, float bsdf_fraction) {
+  return bsdf_fraction * p.bsdf + (1.f - bsdf_fraction) * p.guide;
+}
+
+}  // namespace
+
 float guided_pdf(const Bsdf& bsdf, const SurfaceInteraction& si, Vec3 wo, Vec3 wi, const DirectionalTree& guide,
                  float bsdf_fraction) {
-  return bsdf_fraction * bsdf.pdf(si, wo, wi) + (1.f - bsdf_fraction) * guide.pdf(si.to_world(wi));
+  return mix(mixture_pdfs(bsdf, si, wo, wi, guide), bsdf_fraction);
 }
 
 bool sample_guided(const Bsdf& bsdf, const SurfaceInteraction& si, Vec3 wo, const DirectionalTree& guide,
-                   float bsdf_fraction, float u_lobe, Vec2 u_dir, BsdfSample& out) {
+                   float bsdf_fraction, float u_lobe, Vec2 u_dir, BsdfSample& out, MixturePdfs* parts) {
   if (u_lobe < bsdf_fraction) {
     // (u_lobe / bsdf_fraction is uniform in [0,1) again: the BSDF's own lobe choice.)
     const float u = std::min(u_lobe / bsdf_fraction, 1.f - 0x1p-24f);
@@ -27,7 +39,9 @@ bool sample_guided(const Bsdf& bsdf, const SurfaceInteraction& si, Vec3 wo, cons
     out.eta = 1.f;
     out.delta = false;
   }
-  out.pdf = guided_pdf(bsdf, si, wo, out.wi, guide, bsdf_fraction);
+  const MixturePdfs pdfs = mixture_pdfs(bsdf, si, wo, out.wi, guide);
+  if (parts) *parts = pdfs;
+  out.pdf = mix(pdfs, bsdf_fraction);
   if (!(out.pdf > 0.f)) return false;
   out.weight = bsdf.eval(si, wo, out.wi) * (1.f / out.pdf);  // (black where the BSDF has nothing)
   return true;

@@ -180,6 +180,7 @@ class PathIntegrator final : public Integrator {
     const bool guided = path.guide && !bsdf->is_delta();
     const uint32_t leaf = guided ? path.guide->tree->leaf_of(si.p) : 0;
     const DirectionalTree* guide = guided && path.guide->sample ? &path.guide->tree->sampling(leaf) : nullptr;
+    const float fraction = guide ? path.guide->tree->bsdf_fraction(leaf) : 1.f;
     if (!bsdf->is_delta()) {
       Vertex v;
       v.si = &si;
@@ -190,17 +191,20 @@ class PathIntegrator final : public Integrator {
       v.medium = path.medium;
       v.time = path.ray.time;
       v.guide = guide;
-      v.bsdf_fraction = guide ? path.guide->bsdf_fraction : 1.f;
+      v.bsdf_fraction = fraction;
       path.L += path.throughput * sample_direct(scene, v, u.u_pick, u.u_light, counters);
     }
     BsdfSample bs;
-    if (guide ? !sample_guided(*bsdf, si, wo, *guide, path.guide->bsdf_fraction, u.u_lobe, u.u_dir, bs)
+    MixturePdfs mixture;
+    if (guide ? !sample_guided(*bsdf, si, wo, *guide, fraction, u.u_lobe, u.u_dir, bs, &mixture)
               : !bsdf->sample(si, wo, u.u_lobe, u.u_dir, bs))
       return false;
     const Vec3 wi_world = si.to_world(bs.wi);
     if (!consistent_side(si, wi_world, bs.wi)) return false;
     path.throughput *= bs.weight;
-    if (path.records && !bs.delta) path.records->add(leaf, wi_world, bs.pdf, path.throughput, path.L);
+    if (path.records && !bs.delta)
+      path.records->add(leaf, wi_world, bs.pdf, bs.weight.luminance() * bs.pdf, guide ? &mixture : nullptr,
+                        path.throughput, path.L);
     path.prev_pdf = bs.pdf;
     path.prev_delta = bs.delta;
     path.eta *= bs.eta;

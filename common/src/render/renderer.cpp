@@ -101,7 +101,7 @@ Film render(const Scene& scene, const RenderSettings& settings, const ProgressCa
   double noise = 0;
   std::optional<SpatialTree> tree;
   if (settings.guiding && scene.integrator.type != IntegratorType::Direct && !scene.bounds().empty())
-    tree.emplace(scene.bounds());
+    tree.emplace(scene.bounds(), settings.guiding_settings.bsdf_fraction);
   size_t trained = 0;  // training passes so far
 
   tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);

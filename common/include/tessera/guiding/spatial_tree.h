@@ -10,6 +10,7 @@
 #pragma once
 
 #include "tessera/core/bounds.h"
+#include "tessera/guiding/bsdf_fraction.h"
 #include "tessera/guiding/directional_tree.h"
 
 #include <cstddef>
@@ -26,12 +27,16 @@ struct GuidingSettings {
   double directional_threshold = 0.01;
   /// Cap on the memory of the whole tree.
   size_t max_bytes = size_t(256) << 20;
+  /// Probability of sampling the BSDF rather than the guide, before (or without) learning it.
+  float bsdf_fraction = 0.5f;
+  /// Learn that probability per leaf (bsdf_fraction.h); otherwise it stays `bsdf_fraction`.
+  bool learn_bsdf_fraction = true;
 };
 
 class SpatialTree {
  public:
   /// One leaf over `bounds`, made a cube about its centre (so cuts halve its longest side first).
-  explicit SpatialTree(const Bounds3& bounds);
+  explicit SpatialTree(const Bounds3& bounds, float bsdf_fraction = 0.5f);
 
   /// The leaf whose region holds `p` (a point outside the bounds goes to the nearest region).
   uint32_t leaf_of(Vec3 p) const;
@@ -40,10 +45,17 @@ class SpatialTree {
   /// Records radiance `value` arriving from `dir` in the leaf (see DirectionalTree::record) and
   /// counts the sample, also when `value` is 0. Thread-safe against other record() calls.
   void record(uint32_t leaf, Vec3 dir, float value, float dither);
+  /// The leaf's probability of sampling the BSDF rather than its guide.
+  float bsdf_fraction(uint32_t leaf) const { return leaves_[leaf].bsdf_fraction; }
+  /// Records a guided sample's share of the loss that chooses that probability (BsdfFractionLoss).
+  void record_fraction(uint32_t leaf, float weight, float bsdf_pdf, float guide_pdf) {
+    leaves_[leaf].fraction_loss.record(weight, bsdf_pdf, guide_pdf);
+  }
 
   /// Ends training iteration `iteration` (0, 1, ...): splits the leaves that saw enough samples
   /// (within the memory cap), then makes each leaf's recorded tree its sampling tree and starts a
-  /// refined one for the next iteration. Not thread-safe: at a pass barrier.
+  /// refined one for the next iteration, and (if learned) picks each leaf's BSDF fraction from the
+  /// iteration's loss. Not thread-safe: at a pass barrier.
   void end_iteration(int iteration, const GuidingSettings& settings);
 
   size_t leaf_count() const { return leaves_.size(); }
@@ -61,6 +73,8 @@ class SpatialTree {
   struct Leaf {
     DirectionalTree sampling, building;
     uint64_t samples = 0;
+    BsdfFractionLoss fraction_loss;
+    float bsdf_fraction = 0.5f;
   };
   void split(uint32_t node);
   static size_t leaf_bytes(const Leaf& leaf);

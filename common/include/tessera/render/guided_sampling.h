@@ -13,11 +13,17 @@
 
 namespace tessera {
 
+/// The two densities the mixture combines at a sampled direction (solid angle).
+struct MixturePdfs {
+  float bsdf = 0.f, guide = 0.f;
+};
+
 /// Samples `out` (wi in the local frame of `si`) from the mixture; false when nothing was sampled.
 /// The weight is black for a guided direction where the BSDF is zero. A guided direction's `eta`
-/// is 1 (only Russian roulette reads it).
+/// is 1 (only Russian roulette reads it). `parts`, if given, receives the mixture's components at
+/// a non-delta direction (for learning the fraction, guiding/bsdf_fraction.h).
 bool sample_guided(const Bsdf& bsdf, const SurfaceInteraction& si, Vec3 wo, const DirectionalTree& guide,
-                   float bsdf_fraction, float u_lobe, Vec2 u_dir, BsdfSample& out);
+                   float bsdf_fraction, float u_lobe, Vec2 u_dir, BsdfSample& out, MixturePdfs* parts = nullptr);
 /// The mixture's solid-angle density of the non-delta direction `wi` (local frame).
 float guided_pdf(const Bsdf& bsdf, const SurfaceInteraction& si, Vec3 wo, Vec3 wi, const DirectionalTree& guide,
                  float bsdf_fraction);

@@ -5,6 +5,8 @@
 // (mixture) pdf p, the radiance arriving along wi is what the rest of the path added to the
 // camera's estimate, over the path's throughput after that vertex: Li = dL / T. The guide records
 // luminance(Li) / p, an estimate of the incident radiance integrated over the leaf's cells, at wi.
+// A guided vertex also records luminance(f * cos * Li) / p with the mixture's two pdfs there, the
+// loss from which its leaf learns the BSDF fraction (guiding/bsdf_fraction.h).
 // Its rounding dither comes from a dedicated sampler dimension per vertex (sampler.h), so the
 // statistics are a function of (pixel, sample index, seed) like every sample value.
 #pragma once
@@ -12,6 +14,7 @@
 #include "tessera/core/rgb.h"
 #include "tessera/core/vec.h"
 #include "tessera/guiding/spatial_tree.h"
+#include "tessera/render/guided_sampling.h"
 
 #include <array>
 #include <cstdint>
@@ -25,7 +28,6 @@ struct PathGuide {
   SpatialTree* tree = nullptr;
   bool sample = false;        // guide directions with the tree's learned distributions
   bool train = false;         // record the pass's radiance into the tree
-  float bsdf_fraction = 0.5f; // probability of sampling the BSDF, not the guide
 };
 
 /// The vertices of one path that sampled a direction to record, and at the path's end the
@@ -36,10 +38,15 @@ class GuideRecords {
   /// Dimensions of the dither of vertex k: kDitherDimension + k (far from the sequential ones).
   static constexpr uint32_t kDitherDimension = 0xFFFFFE00u;
 
-  /// A vertex in `leaf` sampled `wi` (world) with density `pdf`; `throughput` is the path's after
-  /// the vertex's weight (before Russian roulette), `radiance` the camera's estimate so far.
-  void add(uint32_t leaf, Vec3 wi, float pdf, const Rgb& throughput, const Rgb& radiance) {
-    if (count_ < kCapacity) vertices_[size_t(count_++)] = {leaf, wi, pdf, throughput, radiance};
+  /// A vertex in `leaf` sampled `wi` (world) with density `pdf`, where the BSDF's f * cos has
+  /// luminance `f_cos`; `throughput` is the path's after the vertex's weight (before Russian
+  /// roulette), `radiance` the camera's estimate so far. `mixture` holds the two pdfs of a guided
+  /// vertex (null when the guide did not sample).
+  void add(uint32_t leaf, Vec3 wi, float pdf, float f_cos, const MixturePdfs* mixture, const Rgb& throughput,
+           const Rgb& radiance) {
+    if (count_ < kCapacity)
+      vertices_[size_t(count_++)] = {leaf, wi, pdf, f_cos, mixture ? *mixture : MixturePdfs{}, mixture != nullptr,
+                                     throughput, radiance};
   }
   /// Records every vertex into `tree` once the path's estimate is `radiance`.
   void commit(SpatialTree& tree, const Rgb& radiance, Sampler& sampler) const;
@@ -48,7 +55,9 @@ class GuideRecords {
   struct Vertex {
     uint32_t leaf;
     Vec3 wi;
-    float pdf;
+    float pdf, f_cos;
+    MixturePdfs mixture;
+    bool guided;
     Rgb throughput, radiance;
   };
   std::array<Vertex, kCapacity> vertices_;
