@@ -37,7 +37,7 @@ int main_entry(int argc, char** argv) {
       ->check(CLI::Range(0.0, 1.0));
   r->add_option("--guiding", render.guiding,
                 "Path guiding (path/volpath): the first half of the samples trains a guide, the rest use it "
-                "(default off)")
+                "and make the image (default off)")
       ->check(CLI::IsMember({"on", "off"}))->capture_default_str();
   r->add_option("--width", render.width, "Film width (default: the scene's)")->check(CLI::PositiveNumber);
   r->add_option("--height", render.height, "Film height (default: the scene's)")->check(CLI::PositiveNumber);

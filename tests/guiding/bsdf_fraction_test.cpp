@@ -52,6 +52,14 @@ TEST(BsdfFraction, TheMixtureClosestToTheProductWins) {
   EXPECT_NEAR(mixed, 0.3f, 0.1001f);
 }
 
+TEST(BsdfFraction, ALowerBoundLimitsTheChoice) {
+  BsdfFractionLoss loss;
+  for (const Record& r : samples([](float x) { return 3.f * guide_pdf(x); }, 20000, 6)) loss.record(r.weight, r.bsdf, r.guide);
+  EXPECT_FLOAT_EQ(loss.best(0.5f), 0.1f);
+  EXPECT_FLOAT_EQ(loss.best(0.5f, 0.3f), 0.3f);
+  EXPECT_FLOAT_EQ(loss.best(0.5f, 1.f), 1.f);
+}
+
 TEST(BsdfFraction, NothingRecordedKeepsTheCurrentFraction) {
   BsdfFractionLoss loss;
   EXPECT_EQ(loss.best(0.7f), 0.7f);
@@ -85,6 +93,7 @@ TEST(BsdfFraction, EachLeafLearnsItsFractionAtTheEndOfAnIteration) {
   box.extend(Vec3(1.f));
   GuidingSettings s;
   s.spatial_threshold = 1e9;  // one leaf
+  s.min_bsdf_fraction = 0.f;
   for (bool learn : {true, false}) {
     s.learn_bsdf_fraction = learn;
     SpatialTree tree(box, 0.5f);

@@ -176,5 +176,26 @@ TEST(DirectionalTree, EvenEnergyIsSplitUntilEachQuadrantIsBelowTheThreshold) {
   EXPECT_EQ(next.node_count(), size_t(1 + 4 + 16 + 64));
 }
 
+TEST(DirectionalTree, ARefinedTreeCanKeepTheEnergyLearnedSoFar) {
+  const DirectionalTree tree = trained(2, 50000);
+  DirectionalTree kept = tree.refined(0.01, /*keep_sums=*/true);
+  DirectionalTree fresh = tree.refined(0.01);
+  ASSERT_GT(kept.node_count(), 1u);
+  kept.build();
+  fresh.build();
+  EXPECT_EQ(fresh.total(), 0u);
+  // The same energy in finer cells: a leaf split into quarters loses at most 3 units of rounding.
+  EXPECT_LE(kept.total(), tree.total());
+  EXPECT_GE(kept.total() + 3 * kept.node_count(), tree.total());
+  // Where the energy is, the density is what it was.
+  const Vec3 lobe = normalize(Vec3(0.3f, -0.5f, 0.8f));
+  EXPECT_NEAR(kept.pdf(lobe), tree.pdf(lobe), 1e-3 * tree.pdf(lobe));
+  // Later records add to it, in the refined structure.
+  for (const Record& r : lobe_records(1000, 99)) kept.record(r.dir, r.value, r.dither);
+  const uint64_t before = kept.total();
+  kept.build();
+  EXPECT_GT(kept.total(), before);
+}
+
 }  // namespace
 }  // namespace tessera

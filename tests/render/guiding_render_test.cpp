@@ -115,6 +115,18 @@ TEST(GuidedRender, TheSameBitsForAnyThreadCountAndTileSize) {
   EXPECT_TRUE(same_bits(render(*scene, off), render(*scene, render_settings(64, 5))));
 }
 
+TEST(GuidedRender, TheImageIsMadeOfThePassesAfterTraining) {
+  auto scene = mixed_scene();
+  // 16 spp: passes 1 2 4 8 | 1; the first three train.
+  RenderSettings s = guided(16, 3);
+  RenderStats stats;
+  const Film discarded = render(*scene, s, {}, &stats);
+  EXPECT_EQ(discarded.pixel({5, 5}).count, 9u);
+  EXPECT_EQ(stats.counters.samples, 16u * uint64_t(discarded.width() * discarded.height()));
+  s.guiding_settings.discard_training = false;
+  EXPECT_EQ(render(*scene, s).pixel({5, 5}).count, 16u);
+}
+
 TEST(GuidedRender, OnlyTheFirstHalfOfTheSamplesTrains) {
   const std::vector<uint32_t> passes = pass_schedule(64);  // 1 2 4 8 16 32 1
   std::vector<bool> trains;

@@ -35,9 +35,11 @@ void BsdfFractionLoss::merge(const BsdfFractionLoss& other) {
   records_ += other.records_;
 }
 
-float BsdfFractionLoss::best(float current) const {
+float BsdfFractionLoss::best(float current, float lowest_allowed) const {
+  int first_candidate = 0;
+  while (first_candidate + 1 < kCandidates && candidate(first_candidate) < lowest_allowed - 1e-6f) ++first_candidate;
   if (records_ == 0) return current;
-  const auto lowest = std::min_element(loss_.begin(), loss_.end());
+  const auto lowest = std::min_element(loss_.begin() + first_candidate, loss_.end());
   return candidate(int(lowest - loss_.begin()));
 }
 

@@ -142,24 +142,29 @@ float DirectionalTree::pdf(Vec3 dir) const {
 }
 
 void DirectionalTree::refine_into(DirectionalTree& out, uint32_t out_node, const Node* node, double scale,
-                                  int depth, double threshold) const {
+                                  uint64_t energy, int depth, double threshold, bool keep_sums) const {
   // `node` null: below a leaf of this tree, whose energy counts as spread evenly over its
-  // quadrants (each then has the share `scale`); otherwise a quadrant's share is its sum times `scale`.
+  // quadrants (each then has the share `scale` and a quarter of `energy`); otherwise a quadrant's
+  // share is its sum times `scale`.
   for (int i = 0; i < 4; ++i) {
     const double share = node ? double(node->sum[i]) * scale : scale;
-    if (depth >= kMaxDepth || !(share > threshold)) continue;
+    const uint64_t quadrant_energy = node ? node->sum[i] : energy / 4;
+    if (depth >= kMaxDepth || !(share > threshold)) {
+      if (keep_sums) out.nodes_[out_node].sum[i] = quadrant_energy;
+      continue;
+    }
     const uint32_t child = uint32_t(out.nodes_.size());
     out.nodes_.emplace_back();
     out.nodes_[out_node].child[i] = child;
     const Node* below = node && node->child[i] != 0 ? &nodes_[node->child[i]] : nullptr;
-    refine_into(out, child, below, below ? scale : share / 4.0, depth + 1, threshold);
+    refine_into(out, child, below, below ? scale : share / 4.0, quadrant_energy, depth + 1, threshold, keep_sums);
   }
 }
 
-DirectionalTree DirectionalTree::refined(double threshold) const {
+DirectionalTree DirectionalTree::refined(double threshold, bool keep_sums) const {
   DirectionalTree out;
   const double total = double(this->total());
-  if (total > 0.0) refine_into(out, 0, &nodes_[0], 1.0 / total, 1, threshold);
+  if (total > 0.0) refine_into(out, 0, &nodes_[0], 1.0 / total, 0, 1, threshold, keep_sums);
   return out;
 }
 

@@ -82,12 +82,12 @@ void SpatialTree::end_iteration(int iteration, const GuidingSettings& settings) 
     const size_t before = leaf_bytes(l);
     l.building.build();
     l.sampling = std::move(l.building);
-    l.building = l.sampling.refined(settings.directional_threshold);
+    l.building = l.sampling.refined(settings.directional_threshold, settings.keep_energy);
     // A refined tree that would not fit keeps the cells it has.
-    if (total - before + leaf_bytes(l) > settings.max_bytes) l.building = l.sampling.cleared();
+    if (total - before + leaf_bytes(l) > settings.max_bytes) l.building = settings.keep_energy ? l.sampling : l.sampling.cleared();
     total = total - before + leaf_bytes(l);
     l.samples = 0;
-    if (settings.learn_bsdf_fraction) l.bsdf_fraction = l.fraction_loss.best(l.bsdf_fraction);
+    if (settings.learn_bsdf_fraction) l.bsdf_fraction = l.fraction_loss.best(l.bsdf_fraction, settings.min_bsdf_fraction);
     l.fraction_loss = {};
   }
 }

@@ -119,7 +119,7 @@ Film render(const Scene& scene, const RenderSettings& settings, const ProgressCa
         FilmTile tile;
         for (size_t i = r.begin(); i != r.end(); ++i) {
           render_tile_with(scene, *integrator, filter, tiles[i], begin, end, settings.seed, pass_guide, tile);
-          film.add_tile(tile);
+          if (!(guide.train && tree && settings.guiding_settings.discard_training)) film.add_tile(tile);
           std::lock_guard<std::mutex> lock(mutex);
           counters += tile.counters;
           ++prog.tiles_done;

@@ -27,8 +27,9 @@ class BsdfFractionLoss {
   void record(float weight, float bsdf_pdf, float guide_pdf);
   /// Adds the sums of another (exact).
   void merge(const BsdfFractionLoss& other);
-  /// The candidate with the lowest loss, or `current` when nothing was recorded.
-  float best(float current) const;
+  /// The candidate (at least `lowest_allowed`) with the lowest loss, or `current` when nothing was
+  /// recorded.
+  float best(float current, float lowest_allowed = 0.f) const;
   bool operator==(const BsdfFractionLoss& other) const = default;
 
  private:

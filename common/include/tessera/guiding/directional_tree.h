@@ -55,9 +55,10 @@ class DirectionalTree {
   float pdf(Vec3 dir) const;
 
   /// The next iteration's tree (of a built tree): a quadrant whose share of the total energy is
-  /// above `threshold` is split (to at most kMaxDepth), a subtree whose share is not is merged;
-  /// sums are zero. A leaf's energy counts as spread evenly over the quadrants it is split into.
-  DirectionalTree refined(double threshold) const;
+  /// above `threshold` is split (to at most kMaxDepth), a subtree whose share is not is merged. A
+  /// leaf's energy counts as spread evenly over the quadrants it is split into. The sums are zero,
+  /// or with `keep_sums` each new cell's energy (rounded down), so later records add to it.
+  DirectionalTree refined(double threshold, bool keep_sums = false) const;
 
   /// The same cells with zero sums (for when a refined tree would not fit the memory cap).
   DirectionalTree cleared() const;
@@ -78,8 +79,8 @@ class DirectionalTree {
   // Quadrant i covers x in [i&1 ? 0.5 : 0, ...) and y in [i&2 ? 0.5 : 0, ...) of its node.
   static int quadrant(Vec2& p);
   uint64_t build_node(uint32_t n);
-  void refine_into(DirectionalTree& out, uint32_t out_node, const Node* node, double scale, int depth,
-                   double threshold) const;
+  void refine_into(DirectionalTree& out, uint32_t out_node, const Node* node, double scale, uint64_t energy,
+                   int depth, double threshold, bool keep_sums) const;
 
   std::vector<Node> nodes_;
 };

@@ -31,6 +31,17 @@ struct GuidingSettings {
   float bsdf_fraction = 0.5f;
   /// Learn that probability per leaf (bsdf_fraction.h); otherwise it stays `bsdf_fraction`.
   bool learn_bsdf_fraction = true;
+  /// The least fraction learning may choose: a BSDF-sampled direction's weight is then at most
+  /// 1 / this times the BSDF's own, so that long paths through over-guided regions cannot
+  /// multiply their throughput at every bounce.
+  float min_bsdf_fraction = 0.3f;
+  /// Each iteration's directional trees start from the energy learned so far, rather than from
+  /// zero (Müller resets them): light found once, such as the sun through a window, stays found.
+  bool keep_energy = true;
+  /// The image is made of the passes after training only (Müller 2017): the training passes,
+  /// sampled with little or nothing learned, carry the fireflies guiding is there to avoid.
+  /// Otherwise every sample counts with weight 1.
+  bool discard_training = true;
 };
 
 class SpatialTree {

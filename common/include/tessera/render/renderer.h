@@ -29,8 +29,9 @@ struct RenderSettings {
   double target_error = 0;
   /// Path guiding (path/volpath only): the passes that end within the first half of the samples
   /// train an SD-tree (guiding_trains_pass), each later pass samples with what the previous
-  /// training passes learned. Every sample counts in the image with weight 1, so it converges to
-  /// the unguided image; the learned trees are the same bits for any thread count or tile size.
+  /// training passes learned. The image is the passes after training (or every pass, see
+  /// GuidingSettings::discard_training), each sample with weight 1, so it converges to the
+  /// unguided image; the learned trees are the same bits for any thread count or tile size.
   bool guiding = false;
   GuidingSettings guiding_settings;
 };
