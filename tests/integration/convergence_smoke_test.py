@@ -1,11 +1,11 @@
 #!/usr/bin/env python3
 """CI smoke run of bench/convergence.sh (docs/performance.md): cornell-box at its reference's
-256x256, spp 1 and 2, every strategy with and without path guiding, into a temporary folder.
+256x256, spp 1 and 4, every strategy with and without path guiding, into a temporary folder.
 Expected: the script exits 0; the CSV has the header and exactly the rows bsdf/nee/mis (each plain,
-then +guiding) x 1/2 spp in that order, with finite positive
+then +guiding) x 1/4 spp in that order, with finite positive
 relMSE and times, a mean ratio within [0.5, 2] and a noise estimate that is infinite at 1 spp (no
-variance from one sample) and finite at 2; the SVG parses as XML with two panels' polylines per
-series. Missing scene/reference files: exit 77 (skip) locally, failure under CI=true."""
+variance from one sample) and finite at 4 (a guided image holds the 3 samples after training); the
+SVG parses as XML with two panels' polylines per series. Missing scene/reference files: exit 77 (skip) locally, failure under CI=true."""
 import argparse
 import csv
 import math
@@ -41,7 +41,7 @@ def main():
         sys.exit(77)
 
     with tempfile.TemporaryDirectory() as out:
-        env = dict(os.environ, TESSERA=args.cli, CONV_SCENES=SCENE, CONV_SPP="1,2", CONV_OUT=out,
+        env = dict(os.environ, TESSERA=args.cli, CONV_SCENES=SCENE, CONV_SPP="1,4", CONV_OUT=out,
                    CONV_STRATEGIES="bsdf,nee,mis", CONV_GUIDING="off,on", CONV_THREADS="2")
         r = subprocess.run(["bash", os.path.join(args.source, "bench", "convergence.sh"), "unused", "0"],
                            env=env, capture_output=True, text=True, timeout=300)
@@ -56,7 +56,7 @@ def main():
         if rows[0] != header:
             fail("CSV header %r" % rows[0])
         got = [(row[0], int(row[1])) for row in rows[1:]]
-        want = [(s + g, n) for s in ("bsdf", "nee", "mis") for g in ("", "+guiding") for n in (1, 2)]
+        want = [(s + g, n) for s in ("bsdf", "nee", "mis") for g in ("", "+guiding") for n in (1, 4)]
         if got != want:
             fail("CSV rows %r, expected %r" % (got, want))
         for row in rows[1:]:
