@@ -84,7 +84,8 @@ void SpatialTree::end_iteration(int iteration, const GuidingSettings& settings) 
     l.sampling = std::move(l.building);
     l.building = l.sampling.refined(settings.directional_threshold, settings.keep_energy);
     // A refined tree that would not fit keeps the cells it has.
-    if (total - before + leaf_bytes(l) > settings.max_bytes) l.building = settings.keep_energy ? l.sampling : l.sampling.cleared();
+    if (total - before + leaf_bytes(l) > settings.max_bytes)
+      l.building = settings.keep_energy ? l.sampling : l.sampling.cleared();
     total = total - before + leaf_bytes(l);
     l.samples = 0;
     if (settings.learn_bsdf_fraction) l.bsdf_fraction = l.fraction_loss.best(l.bsdf_fraction, settings.min_bsdf_fraction);
@@ -93,17 +94,7 @@ void SpatialTree::end_iteration(int iteration, const GuidingSettings& settings) 
 }
 
 bool SpatialTree::operator==(const SpatialTree& other) const {
-  if (nodes_.size() != other.nodes_.size() || leaves_.size() != other.leaves_.size()) return false;
-  for (size_t n = 0; n < nodes_.size(); ++n)
-    if (nodes_[n].leaf != other.nodes_[n].leaf || nodes_[n].child[0] != other.nodes_[n].child[0] ||
-        nodes_[n].child[1] != other.nodes_[n].child[1])
-      return false;
-  for (size_t l = 0; l < leaves_.size(); ++l)
-    if (leaves_[l].samples != other.leaves_[l].samples || !(leaves_[l].sampling == other.leaves_[l].sampling) ||
-        !(leaves_[l].building == other.leaves_[l].building) || leaves_[l].bsdf_fraction != other.leaves_[l].bsdf_fraction ||
-        !(leaves_[l].fraction_loss == other.leaves_[l].fraction_loss))
-      return false;
-  return true;
+  return nodes_ == other.nodes_ && leaves_ == other.leaves_;
 }
 
 }  // namespace tessera

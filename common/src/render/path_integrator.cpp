@@ -203,8 +203,8 @@ class PathIntegrator final : public Integrator {
     if (!consistent_side(si, wi_world, bs.wi)) return false;
     path.throughput *= bs.weight;
     if (path.records && !bs.delta)
-      path.records->add(leaf, wi_world, bs.pdf, bs.weight.luminance() * bs.pdf, guide ? &mixture : nullptr,
-                        path.throughput, path.L);
+      path.records->add(leaf, wi_world, bs.pdf, bs.weight.luminance() * bs.pdf,
+                        guide ? std::optional(mixture) : std::nullopt, path.throughput, path.L);
     path.prev_pdf = bs.pdf;
     path.prev_delta = bs.delta;
     path.eta *= bs.eta;

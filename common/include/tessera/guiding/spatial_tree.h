@@ -80,12 +80,14 @@ class SpatialTree {
   struct Node {
     uint32_t child[2] = {0, 0};  // (below `lo`/above the midpoint along axis = depth % 3)
     uint32_t leaf = kNoLeaf;
+    bool operator==(const Node&) const = default;
   };
   struct Leaf {
     DirectionalTree sampling, building;
     uint64_t samples = 0;
     BsdfFractionLoss fraction_loss;
     float bsdf_fraction = 0.5f;
+    bool operator==(const Leaf&) const = default;
   };
   void split(uint32_t node);
   static size_t leaf_bytes(const Leaf& leaf);

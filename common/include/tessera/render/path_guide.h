@@ -18,6 +18,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 
 namespace tessera {
 
@@ -41,12 +42,10 @@ class GuideRecords {
   /// A vertex in `leaf` sampled `wi` (world) with density `pdf`, where the BSDF's f * cos has
   /// luminance `f_cos`; `throughput` is the path's after the vertex's weight (before Russian
   /// roulette), `radiance` the camera's estimate so far. `mixture` holds the two pdfs of a guided
-  /// vertex (null when the guide did not sample).
-  void add(uint32_t leaf, Vec3 wi, float pdf, float f_cos, const MixturePdfs* mixture, const Rgb& throughput,
+  /// vertex (none when the guide did not sample).
+  void add(uint32_t leaf, Vec3 wi, float pdf, float f_cos, std::optional<MixturePdfs> mixture, const Rgb& throughput,
            const Rgb& radiance) {
-    if (count_ < kCapacity)
-      vertices_[size_t(count_++)] = {leaf, wi, pdf, f_cos, mixture ? *mixture : MixturePdfs{}, mixture != nullptr,
-                                     throughput, radiance};
+    if (count_ < kCapacity) vertices_[size_t(count_++)] = {leaf, wi, pdf, f_cos, mixture, throughput, radiance};
   }
   /// Records every vertex into `tree` once the path's estimate is `radiance`.
   void commit(SpatialTree& tree, const Rgb& radiance, Sampler& sampler) const;
@@ -56,8 +55,7 @@ class GuideRecords {
     uint32_t leaf;
     Vec3 wi;
     float pdf, f_cos;
-    MixturePdfs mixture;
-    bool guided;
+    std::optional<MixturePdfs> mixture;
     Rgb throughput, radiance;
   };
   std::array<Vertex, kCapacity> vertices_;
