@@ -10,6 +10,7 @@
 # Environment (for the CI smoke run and experiments):
 #   CONV_SCENES="cornell-box ..."  CONV_STRATEGIES=bsdf,nee,mis  CONV_SPP=1,2,4  CONV_OUT=docs/performance
 #   CONV_GUIDING=off,on (path guiding, each strategy with each; default off)
+#   CONV_ADAPTIVE=off,on (adaptive sampling, each series with each; default off)
 #   CONV_THREADS=N (default: all cores)  TESSERA=path/to/tessera (default: BUILD_DIR/cli/tessera)
 # A missing scene or reference is an error (exit 1), never a skip.
 set -euo pipefail
@@ -21,6 +22,7 @@ shared=../shared
 scenes=(${CONV_SCENES:-cornell-box veach-mis living-room bathroom})
 strategies=${CONV_STRATEGIES:-bsdf,nee,mis}
 guiding=${CONV_GUIDING:-off}
+adaptive=${CONV_ADAPTIVE:-off}
 spp=${CONV_SPP:-1,2,4}
 out=${CONV_OUT:-docs/performance}
 threads=${CONV_THREADS:-$(nproc)}
@@ -39,9 +41,9 @@ for s in "${scenes[@]}"; do
   res=$(grep -o 'Resolution [0-9]*×[0-9]*' "$shared/references/$s/README.md" | grep -o '[0-9][0-9]*')
   w=$(echo "$res" | sed -n 1p); h=$(echo "$res" | sed -n 2p)
   [ -n "$w" ] && [ -n "$h" ] || { echo "convergence.sh: no resolution in $shared/references/$s/README.md" >&2; exit 1; }
-  echo "== $s ${w}x${h} strategies=$strategies guiding=$guiding spp=$spp budget=${budget}s threads=$threads" >&2
+  echo "== $s ${w}x${h} strategies=$strategies guiding=$guiding adaptive=$adaptive spp=$spp budget=${budget}s threads=$threads" >&2
   "$tessera" bench convergence "$shared/scenes/$s/scene.xml" --reference "$shared/references/$s/reference.exr" \
     --width "$w" --height "$h" --spp "$spp" "${seconds_args[@]}" --strategy "$strategies" --guiding "$guiding" \
-    --threads "$threads" \
+    --adaptive "$adaptive" --threads "$threads" \
     --csv "$out/$s.csv" --plot "$out/$s.svg" | tee "$out/$s.txt"
 done

@@ -37,7 +37,11 @@ int main_entry(int argc, char** argv) {
       ->check(CLI::Range(0.0, 1.0));
   r->add_option("--guiding", render.guiding,
                 "Path guiding (path/volpath): the first half of the samples trains a guide, the rest use it "
-                "and make the image (default off)")
+                "and make the image (default: on for a guided_path integrator, else off)")
+      ->check(CLI::IsMember({"on", "off"}));
+  r->add_option("--adaptive", render.adaptive,
+                "Adaptive sampling: after the first quarter of the samples, each pass spends its samples "
+                "where the estimated error is (--spp stays the total; default off)")
       ->check(CLI::IsMember({"on", "off"}))->capture_default_str();
   r->add_option("--width", render.width, "Film width (default: the scene's)")->check(CLI::PositiveNumber);
   r->add_option("--height", render.height, "Film height (default: the scene's)")->check(CLI::PositiveNumber);
@@ -79,6 +83,8 @@ int main_entry(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   bc->add_option("--guiding", conv.guiding, "Path guiding, e.g. off,on: each strategy with each (default off); "
                  "guided series are named STRATEGY+guiding")->delimiter(',')->check(CLI::IsMember({"off", "on"}));
+  bc->add_option("--adaptive", conv.adaptive, "Adaptive sampling, e.g. off,on: each series with each (default off); "
+                 "adaptive series are named SERIES+adaptive")->delimiter(',')->check(CLI::IsMember({"off", "on"}));
   bc->add_option("--strategy", conv.strategies, "Sampling strategies: mis, bsdf, nee (default mis)")->delimiter(',')
       ->check(CLI::IsMember({"mis", "bsdf", "nee"}));
   bc->add_option("--csv", conv.csv, "Write the measurements here");

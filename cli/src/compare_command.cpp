@@ -1,6 +1,8 @@
-// `tessera compare`: error of a render against a reference image (relMSE, MSE, channel means, and with
-// the reference's per-pixel variance a z-score summary). Used by bench/ scripts and by people.
+// `tessera compare`: error of a render against a reference image (relMSE, with and without the worst
+// 0.1% of pixels, MSE, channel means; with the reference's per-pixel variance a z-score summary and
+// the relMSE the reference's own noise adds). Used by bench/ scripts and by people.
 #include "tessera/cli/commands.h"
+#include "tessera/cli/convergence.h"
 #include "tessera/image/image.h"
 #include "tessera/image/image_compare.h"
 #include "tessera/scene/error.h"
@@ -21,12 +23,14 @@ int run_compare(const CompareOptions& options) {
     }
     auto m = channel_means(image);
     auto r = channel_means(ref);
-    std::printf("compare rel_mse=%.6g mse=%.6g mean=%.6g,%.6g,%.6g ref_mean=%.6g,%.6g,%.6g non_finite=%zu", rel_mse(image, ref),
-                mse(image, ref), m[0], m[1], m[2], r[0], r[1], r[2], count_non_finite(image));
+    std::printf("compare rel_mse=%.6g rel_mse_trim=%.6g mse=%.6g mean=%.6g,%.6g,%.6g ref_mean=%.6g,%.6g,%.6g non_finite=%zu",
+                rel_mse(image, ref), measure_error(image, ref).rel_mse_trim, mse(image, ref), m[0], m[1], m[2], r[0], r[1],
+                r[2], count_non_finite(image));
     if (!options.variance.empty()) {
       Image var = read_image(options.variance).to_rgb();
       ZScoreStats z = z_score_stats(image, ref, var);
-      std::printf(" z_mean=%.4f z_mean_sq=%.4f frac_z_above_4=%.6f", z.mean_z, z.mean_z2, z.frac_above_4);
+      std::printf(" z_mean=%.4f z_mean_sq=%.4f frac_z_above_4=%.6f ref_floor=%.6g", z.mean_z, z.mean_z2, z.frac_above_4,
+                  rel_mse_floor(ref, var));
     }
     std::printf("\n");
     return 0;

@@ -43,21 +43,25 @@ void print_time_to_target(const std::string& strategy, const std::vector<Converg
 }  // namespace
 
 int run_bench_convergence(const ConvergenceOptions& options) {
-  // A series: a strategy, with or without guiding, named "mis" or "mis+guiding".
+  // A series: a strategy, with or without guiding and adaptive sampling, named e.g. "mis",
+  // "mis+guiding" or "mis+guiding+adaptive".
   struct Series {
     std::string name;
     SamplingStrategy strategy;
-    bool guiding;
+    bool guiding, adaptive;
   };
   std::vector<Series> series;
-  const std::vector<std::string> guiding = options.guiding.empty() ? std::vector<std::string>{"off"} : options.guiding;
+  const auto or_off = [](const std::vector<std::string>& v) { return v.empty() ? std::vector<std::string>{"off"} : v; };
+  const std::vector<std::string> guiding = or_off(options.guiding), adaptive = or_off(options.adaptive);
   for (const auto& name : options.strategies.empty() ? std::vector<std::string>{"mis"} : options.strategies) {
     SamplingStrategy s;
     if (!parse_sampling_strategy(name, s)) {
       std::fprintf(stderr, "tessera bench convergence: unknown strategy '%s' (use mis, bsdf, nee)\n", name.c_str());
       return 2;
     }
-    for (const auto& g : guiding) series.push_back({g == "on" ? name + "+guiding" : name, s, g == "on"});
+    for (const auto& g : guiding)
+      for (const auto& a : adaptive)
+        series.push_back({name + (g == "on" ? "+guiding" : "") + (a == "on" ? "+adaptive" : ""), s, g == "on", a == "on"});
   }
   std::vector<int> budgets = options.spp;
   if (budgets.empty() && options.seconds <= 0) budgets = {1, 2, 4, 8, 16, 32, 64};
@@ -98,6 +102,8 @@ int run_bench_convergence(const ConvergenceOptions& options) {
     for (const Series& one : series) {
       scene.integrator.strategy = one.strategy;
       settings.guiding = one.guiding;
+      if (scene.integrator.guiding) settings.guiding_settings = *scene.integrator.guiding;
+      settings.adaptive = one.adaptive;
       std::vector<ConvergencePoint> mine;
       auto run_budget = [&](size_t index, int spp) {
         settings.spp = spp;

@@ -125,7 +125,10 @@ int run_render(const RenderOptions& options) {
     settings.threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
     settings.tile_size = options.tile_size;
     settings.target_error = options.target_error;
-    settings.guiding = options.guiding == "on";
+    // Guiding as the command line says, else as the scene's integrator does (guided_path).
+    settings.guiding = options.guiding.empty() ? scene.integrator.guiding.has_value() : options.guiding == "on";
+    if (scene.integrator.guiding) settings.guiding_settings = *scene.integrator.guiding;
+    settings.adaptive = options.adaptive == "on";
 
     const std::vector<uint32_t> passes = pass_schedule(uint32_t(settings.spp));
     Progress progress("render", !options.quiet);

@@ -39,6 +39,12 @@ LoadedJobScene load_job_scene(const std::string& bundle_dir, const std::string& 
 JobPlan make_job_plan(const std::string& bundle_dir, const std::string& scene_file, const JobSettings& settings,
                       const LoadedJobScene& scene) {
   const Scene& s = *scene.loaded.scene;
+  // The farm does not guide yet: rendering such a scene unguided would give another image than
+  // `tessera render` does with the same flags.
+  if (s.integrator.guiding)
+    throw SceneError(FileLoc{scene_file, 0}, "the scene's guided_path integrator asks for path guiding, which the farm "
+                                             "does not do yet; render it with `tessera render`, or submit it with "
+                                             "--integrator path");
   JobPlan plan;
   plan.settings = settings;
   plan.settings.spp = s.sampler.sample_count;

@@ -1,5 +1,6 @@
 // The `tessera` command in-process: render writes EXR (with its header attributes), PFM and PNG;
-// -D reaches the scene; errors give exit code 1 or 2; compare reports errors against a reference.
+// -D reaches the scene; errors give exit code 1 or 2; a guided_path scene renders guided unless
+// --guiding off; --adaptive changes the samples; compare reports errors against a reference.
 #include "tessera/cli/commands.h"
 #include "tessera/image/image.h"
 #include "tessera/image/image_compare.h"
@@ -10,6 +11,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <string>
 #include <vector>
 
 namespace tessera {
@@ -99,6 +102,34 @@ TEST_F(CliTest, EveryIntegratorTheLoaderKnowsIsAccepted) {
     EXPECT_EQ(run({"render", scene, "-o", out, "--integrator", integrator, "-q"}), 0) << integrator;
     EXPECT_TRUE(fs::exists(out)) << integrator;
   }
+}
+
+TEST_F(CliTest, GuidingFollowsTheScenesIntegratorUnlessToldAndAdaptiveIsAFlag) {
+  std::string scene = write_scene();
+  std::string xml;
+  {
+    std::ifstream in(scene);
+    xml.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  const std::string guided_xml = std::string(xml).insert(xml.find("<sensor"), R"(<integrator type="guided_path">
+    <string name="budgetType" value="spp"/><float name="budget" value="32"/>
+    <string name="sampleCombination" value="discard"/></integrator>
+  )");
+  std::ofstream(path("g.xml")) << guided_xml;
+  const auto render_to = [&](const std::string& file, const std::string& out, std::vector<std::string> flags) {
+    std::vector<std::string> args = {"render", file, "-o", path(out), "--seed", "3", "-q"};
+    args.insert(args.end(), flags.begin(), flags.end());
+    return run(args);
+  };
+  ASSERT_EQ(render_to(path("g.xml"), "guided.exr", {}), 0);
+  ASSERT_EQ(render_to(path("g.xml"), "off.exr", {"--guiding", "off"}), 0);
+  ASSERT_EQ(render_to(scene, "plain.exr", {"--spp", "32"}), 0);
+  ASSERT_EQ(render_to(scene, "adaptive.exr", {"--spp", "32", "--adaptive", "on"}), 0);
+  const Image plain = read_exr(path("plain.exr"));
+  EXPECT_EQ(rel_mse(read_exr(path("off.exr")), plain), 0.0);  // guided_path without guiding is path
+  EXPECT_GT(rel_mse(read_exr(path("guided.exr")), plain), 0.0);
+  EXPECT_GT(rel_mse(read_exr(path("adaptive.exr")), plain), 0.0);
+  EXPECT_NE(render_to(scene, "x.exr", {"--adaptive", "maybe"}), 0);
 }
 
 TEST_F(CliTest, CompareReportsAgainstAReference) {

@@ -1,6 +1,7 @@
 // Bundling real scenes: the files a scene references (scene_files), their common root
 // (plan_bundle), packing, and the round trip pack -> inspect -> unpack -> load.
 #include "tessera/farm/bundle.h"
+#include "tessera/farm/job_scene.h"
 
 #include "tessera/image/image.h"
 #include "tessera/scene/load_context.h"
@@ -244,6 +245,26 @@ TEST(BundlePlan, RootIsTheDeepestCommonFolder) {
   BundlePlan alone = plan_bundle("/s/scene.xml", {});
   EXPECT_EQ(alone.root_dir, "/s");
   EXPECT_EQ(alone.files, std::vector<std::string>{"scene.xml"});
+}
+
+TEST(JobPlan, AGuidedPathSceneIsRefusedUntilTheFarmGuides) {
+  TempDir t;
+  std::ofstream(t.path / "scene.xml") << R"(<scene version="0.6.0">
+  <integrator type="guided_path"><string name="budgetType" value="spp"/><float name="budget" value="16"/>
+    <string name="sampleCombination" value="discard"/></integrator>
+  <shape type="sphere"/>
+</scene>)";
+  JobSettings settings;
+  try {
+    (void)make_job_plan(t.path.string(), "scene.xml", settings, load_job_scene(t.path.string(), "scene.xml", settings));
+    ADD_FAILURE() << "no error";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("scene.xml"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("--integrator path"), std::string::npos) << e.what();
+  }
+  settings.integrator = "path";  // what the error suggests
+  EXPECT_NO_THROW(
+      (void)make_job_plan(t.path.string(), "scene.xml", settings, load_job_scene(t.path.string(), "scene.xml", settings)));
 }
 
 }  // namespace

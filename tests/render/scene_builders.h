@@ -119,4 +119,70 @@ inline std::unique_ptr<Scene> mixed_scene() {
   return std::move(r.scene);
 }
 
+// Fog around a glass ball filled with a denser medium, a rough metal ball and a diffuse floor,
+// lit by a sphere light and a dim sky.
+inline const char* kFogScene = R"(<scene version="3.0.0">
+  <integrator type="volpath"><integer name="max_depth" value="10"/></integrator>
+  <sensor type="perspective"><float name="fov" value="45"/>
+    <transform name="to_world"><lookat origin="0,1,5" target="0,0.7,0" up="0,1,0"/></transform>
+    <medium type="homogeneous" name="medium" id="fog"><float name="sigma_t" value="0.1"/>
+      <rgb name="albedo" value="0.8,0.8,0.9"/></medium>
+    <sampler type="independent"/>
+    <film type="hdrfilm"><integer name="width" value="32"/><integer name="height" value="24"/>
+      <rfilter type="box"/></film>
+  </sensor>
+  <shape type="rectangle"><transform name="to_world"><rotate x="1" angle="-90"/><scale value="4"/></transform>
+    <bsdf type="diffuse"/><ref name="exterior" id="fog"/></shape>
+  <shape type="sphere"><point name="center" value="-0.7,0.7,0"/><float name="radius" value="0.6"/>
+    <bsdf type="dielectric"/>
+    <medium type="homogeneous" name="interior"><float name="sigma_t" value="1.5"/>
+      <rgb name="albedo" value="0.9,0.6,0.4"/></medium>
+    <ref name="exterior" id="fog"/></shape>
+  <shape type="sphere"><point name="center" value="0.8,0.5,0.3"/><float name="radius" value="0.5"/>
+    <bsdf type="roughconductor"><float name="alpha" value="0.25"/></bsdf><ref name="exterior" id="fog"/></shape>
+  <shape type="sphere"><point name="center" value="0.5,2.6,1"/><float name="radius" value="0.6"/>
+    <emitter type="area"><rgb name="radiance" value="8,7,6"/></emitter><ref name="exterior" id="fog"/></shape>
+  <emitter type="constant"><rgb name="radiance" value="0.2,0.25,0.3"/></emitter>
+</scene>)";
+
+// A closed room lit only by a sky seen through a window pane, which next-event estimation
+// cannot see through: every light path leaves through the pane by sampling (the case guiding is for).
+inline const char* kWindowScene = R"(<scene version="3.0.0">
+  <integrator type="path"><integer name="max_depth" value="8"/></integrator>
+  <sensor type="perspective"><float name="fov" value="70"/>
+    <transform name="to_world"><lookat origin="0,0,0.9" target="0,-0.2,0" up="0,1,0"/></transform>
+    <sampler type="independent"/>
+    <film type="hdrfilm"><integer name="width" value="32"/><integer name="height" value="24"/>
+      <rfilter type="box"/></film>
+  </sensor>
+  <bsdf type="diffuse" id="wall"><rgb name="reflectance" value="0.7,0.6,0.5"/></bsdf>
+  <shape type="rectangle"><transform name="to_world"><rotate x="1" angle="-90"/><translate y="-1"/></transform><ref id="wall"/></shape>
+  <shape type="rectangle"><transform name="to_world"><rotate x="1" angle="90"/><translate y="1"/></transform><ref id="wall"/></shape>
+  <shape type="rectangle"><transform name="to_world"><translate z="-1"/></transform><ref id="wall"/></shape>
+  <shape type="rectangle"><transform name="to_world"><rotate y="1" angle="180"/><translate z="1"/></transform><ref id="wall"/></shape>
+  <shape type="rectangle"><transform name="to_world"><rotate y="1" angle="-90"/><translate x="1"/></transform>
+    <bsdf type="roughconductor"><float name="alpha" value="0.3"/></bsdf></shape>
+  <shape type="rectangle"><transform name="to_world"><scale value="0.5"/><rotate y="1" angle="90"/><translate x="-1"/></transform>
+    <bsdf type="thindielectric"/></shape>
+  <shape type="rectangle"><transform name="to_world"><scale x="1" y="0.25"/><rotate y="1" angle="90"/>
+    <translate x="-1" y="0.75"/></transform><ref id="wall"/></shape>
+  <shape type="rectangle"><transform name="to_world"><scale x="1" y="0.25"/><rotate y="1" angle="90"/>
+    <translate x="-1" y="-0.75"/></transform><ref id="wall"/></shape>
+  <shape type="rectangle"><transform name="to_world"><scale x="0.25" y="0.5"/><rotate y="1" angle="90"/>
+    <translate x="-1" z="0.75"/></transform><ref id="wall"/></shape>
+  <shape type="rectangle"><transform name="to_world"><scale x="0.25" y="0.5"/><rotate y="1" angle="90"/>
+    <translate x="-1" z="-0.75"/></transform><ref id="wall"/></shape>
+  <emitter type="constant"><rgb name="radiance" value="3,3,3.5"/></emitter>
+</scene>)";
+
+inline std::unique_ptr<Scene> window_scene() {
+  LoadResult r = load_scene(parse_scene_string(kWindowScene, "window_scene.xml"), LoadOptions{});
+  return std::move(r.scene);
+}
+
+inline std::unique_ptr<Scene> fog_scene() {
+  LoadResult r = load_scene(parse_scene_string(kFogScene, "fog_scene.xml"), LoadOptions{});
+  return std::move(r.scene);
+}
+
 }  // namespace tessera::test

@@ -54,6 +54,10 @@ double rel_mse(const Image& a, const Image& ref, double epsilon) {
   });
 }
 
+double rel_mse_floor(const Image& ref, const Image& ref_variance, double epsilon) {
+  return mean_over_values(ref_variance, ref, "rel_mse_floor", [epsilon](double v, double r) { return v / (r * r + epsilon); });
+}
+
 double mse(const Image& a, const Image& b) {
   return mean_over_values(a, b, "mse", [](double x, double y) { return (x - y) * (x - y); });
 }

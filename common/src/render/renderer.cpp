@@ -1,6 +1,7 @@
 #include "tessera/render/renderer.h"
 
 #include "tessera/core/check.h"
+#include "tessera/render/adaptive.h"
 #include "tessera/render/integrator.h"
 #include "tessera/render/noise_estimate.h"
 #include "tessera/render/sampler.h"
@@ -46,7 +47,7 @@ std::vector<TileRect> make_tiles(const TileRect& window, int tile_size) {
 namespace {
 
 void render_tile_with(const Scene& scene, const Integrator& integrator, const Filter* filter,
-                      const TileRect& rect, uint32_t sample_begin, uint32_t sample_end, uint32_t seed,
+                      const TileRect& rect, const PassSamples& samples, uint32_t seed,
                       const PathGuide* guide, FilmTile& tile) {
   TESSERA_CHECK(scene.camera != nullptr);
   tile.reset(rect);
@@ -55,6 +56,8 @@ void render_tile_with(const Scene& scene, const Integrator& integrator, const Fi
   const float open = scene.shutter_open, shutter = scene.shutter_close - scene.shutter_open;
   for (int y = rect.y0; y < rect.y1; ++y) {
     for (int x = rect.x0; x < rect.x1; ++x) {
+      const size_t i = samples.index({x, y});
+      const uint32_t sample_begin = samples.first[i], sample_end = sample_begin + samples.count[i];
       for (uint32_t s = sample_begin; s < sample_end; ++s) {
         sampler.start_pixel_sample({x, y}, s);
         Vec2 u_film = sampler.next_2d();
@@ -79,7 +82,13 @@ void render_tile_with(const Scene& scene, const Integrator& integrator, const Fi
 void render_tile(const Scene& scene, const TileRect& rect, uint32_t sample_begin, uint32_t sample_end,
                  uint32_t seed, FilmTile& tile) {
   auto integrator = make_integrator(scene.integrator);
-  render_tile_with(scene, *integrator, scene.film.filter.get(), rect, sample_begin, sample_end, seed, nullptr, tile);
+  render_tile(scene, rect, PassSamples::uniform(rect, sample_begin, sample_end), seed, tile);
+}
+
+void render_tile(const Scene& scene, const TileRect& rect, const PassSamples& samples, uint32_t seed, FilmTile& tile) {
+  TESSERA_CHECK(samples.rect.contains(rect));
+  auto integrator = make_integrator(scene.integrator);
+  render_tile_with(scene, *integrator, scene.film.filter.get(), rect, samples, seed, nullptr, tile);
 }
 
 Film render(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress,
@@ -103,22 +112,24 @@ Film render(const Scene& scene, const RenderSettings& settings, const ProgressCa
   if (settings.guiding && scene.integrator.type != IntegratorType::Direct && !scene.bounds().empty())
     tree.emplace(scene.bounds(), settings.guiding_settings.bsdf_fraction);
   size_t trained = 0;  // training passes so far
+  std::vector<uint32_t> taken(size_t(film.window().area()), 0);  // per pixel: its next sample index
 
   tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
   arena.execute([&] {
     uint32_t begin = 0;
     for (size_t p = 0; p < passes.size(); ++p) {
-      const uint32_t end = begin + passes[p];
       prog.pass = int(p);
       // A pass samples with what earlier passes learned, and trains if it is a training pass.
       PathGuide guide{tree ? &*tree : nullptr, trained > 0, guiding_trains_pass(passes, p, uint32_t(settings.spp))};
       const PathGuide* pass_guide = guide.tree && (guide.sample || guide.train) ? &guide : nullptr;
+      const PassSamples samples = plan_pass(film, taken, begin, passes[p], uint32_t(settings.spp),
+                                            settings.adaptive ? &settings.adaptive_settings : nullptr);
       // Tiles are disjoint, so adding their sums concurrently touches distinct pixels; passes are
       // separated by the parallel_for barrier, which fixes the per-pixel order of pass sums.
       tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
         FilmTile tile;
         for (size_t i = r.begin(); i != r.end(); ++i) {
-          render_tile_with(scene, *integrator, filter, tiles[i], begin, end, settings.seed, pass_guide, tile);
+          render_tile_with(scene, *integrator, filter, tiles[i], samples, settings.seed, pass_guide, tile);
           if (!(guide.train && tree && settings.guiding_settings.discard_training)) film.add_tile(tile);
           std::lock_guard<std::mutex> lock(mutex);
           counters += tile.counters;
@@ -127,8 +138,9 @@ Film render(const Scene& scene, const RenderSettings& settings, const ProgressCa
         }
       });
       if (pass_guide && guide.train) tree->end_iteration(int(trained++), settings.guiding_settings);  // (at the barrier)
-      begin = end;
-      prog.samples_done = end;
+      for (size_t i = 0; i < taken.size(); ++i) taken[i] += samples.count[i];
+      begin += passes[p];
+      prog.samples_done = begin;
       if (settings.target_error > 0 && p + 1 < passes.size()) {
         noise = estimate_noise(film).rel_mse;
         if (noise <= settings.target_error) break;

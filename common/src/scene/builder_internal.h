@@ -18,9 +18,13 @@ struct BuildState {
   /// Nodes whose own parameters are not checked (e.g. an unsupported sensor read as a pinhole
   /// camera), though their children are.
   std::set<const SceneNode*> params_exempt;
+  /// > 0: samples per pixel an integrator's own budget asks for (guided_path), over the sampler's.
+  int spp_budget = 0;
 };
 
 void build_integrator(BuildState& st);
+/// A `guided_path` integrator's guiding parameters (guided_path_builder.cpp).
+void read_guided_path(BuildState& st, const SceneNode& node);
 void build_sensor(BuildState& st);  // after the shapes: a missing sensor is fitted to the scene bounds
 void build_shapes(BuildState& st);
 // The sensor's shutterOpen/shutterClose into scene.shutter_*: before the shapes, which move over it.

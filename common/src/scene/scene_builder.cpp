@@ -286,6 +286,11 @@ LoadResult load_scene(const SceneDesc& desc, const LoadOptions& options) {
   detail::build_shapes(st);
   detail::build_emitters(st);
   detail::build_sensor(st);
+  if (st.spp_budget > 0 && st.spp_budget != scene->sampler.sample_count) {
+    ctx.note(desc.root->loc, "the integrator's budget of " + std::to_string(st.spp_budget) +
+                                 " samples per pixel replaces the sampler's " + std::to_string(scene->sampler.sample_count));
+    scene->sampler.sample_count = st.spp_budget;
+  }
   detail::finish_media(st);
   detail::report_unsupported(st);
   if (!options.allow_unsupported && !ctx.unsupported_items().empty())

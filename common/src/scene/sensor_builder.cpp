@@ -252,6 +252,9 @@ void build_integrator(BuildState& st) {
     s.type = IntegratorType::VolPath;  // finish_media() makes it path when there are no media
   } else if (type == "direct") {
     s.type = IntegratorType::Direct;
+  } else if (type == "guided_path") {
+    s.type = IntegratorType::Path;  // (the plugin is a surface path tracer)
+    read_guided_path(st, *node);
   } else if (substituted_by_path_tracer(type)) {
     st.ctx.note(node->loc, node->describe() + " is rendered by Tessera's path tracer (volpath where the scene has media): "
                                "the same expected image, except for light paths a path tracer cannot sample, "

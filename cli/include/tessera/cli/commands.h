@@ -22,7 +22,8 @@ struct RenderOptions {
   std::string integrator;                  // empty: as the scene says
   std::string light_selection;             // "power" or "bvh"; empty: the default (bvh)
   double target_error = 0;                 // > 0: stop at this estimated relMSE (spp is the budget)
-  std::string guiding = "off";             // path guiding: "on" or "off"
+  std::string guiding;                     // path guiding: "on", "off"; empty: as the scene says
+  std::string adaptive = "off";            // adaptive sampling: "on" or "off"
   bool allow_unsupported = false;
   bool quiet = false;
 };

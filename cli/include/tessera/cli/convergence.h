@@ -23,6 +23,7 @@ struct ConvergenceOptions {
   double seconds = 0;
   std::vector<std::string> strategies;  // "mis", "bsdf", "nee"; empty: mis
   std::vector<std::string> guiding;     // "off", "on" (each strategy with each); empty: off
+  std::vector<std::string> adaptive;    // "off", "on" (each series with each); empty: off
   std::string csv, plot;                // output paths; empty: not written
   int width = 0, height = 0;            // > 0: film size (the reference must match it)
   int threads = 0;                      // 0: all cores

@@ -20,6 +20,9 @@ size_t count_non_finite(const Image& image);
 /// which say nothing about bias) from dominating; a pixel of 0.1 has its weight halved, pixels
 /// above ~0.3 are almost purely relative. Throws std::invalid_argument on a size/channel mismatch.
 double rel_mse(const Image& a, const Image& ref, double epsilon = 1e-2);
+/// What rel_mse against `ref` gains in expectation from the reference's own noise, given its
+/// per-pixel variance: mean of var / (ref^2 + epsilon). A render's error cannot go below it.
+double rel_mse_floor(const Image& ref, const Image& ref_variance, double epsilon = 1e-2);
 double mse(const Image& a, const Image& b);
 /// Mean over pixels and channels of |a - b|.
 double mean_abs_error(const Image& a, const Image& b);

@@ -9,6 +9,7 @@
 #pragma once
 
 #include "tessera/guiding/spatial_tree.h"
+#include "tessera/render/adaptive.h"
 #include "tessera/render/film.h"
 #include "tessera/render/scene.h"
 
@@ -34,6 +35,10 @@ struct RenderSettings {
   /// unguided image; the learned trees are the same bits for any thread count or tile size.
   bool guiding = false;
   GuidingSettings guiding_settings;
+  /// Adaptive sampling (adaptive.h): later passes spend their samples where the film's variance
+  /// estimate says the error is. spp stays the total; a pixel's samples keep consecutive indices.
+  bool adaptive = false;
+  AdaptiveSettings adaptive_settings;
 };
 
 struct RenderStats {
@@ -66,6 +71,9 @@ std::vector<TileRect> make_tiles(const TileRect& window, int tile_size);
 /// to `rect` first. Uses the scene's camera, filter, sampler type and integrator.
 void render_tile(const Scene& scene, const TileRect& rect, uint32_t sample_begin, uint32_t sample_end,
                  uint32_t seed, FilmTile& tile);
+
+/// Renders, for every pixel of `rect`, the samples `samples` gives it (samples.rect contains rect).
+void render_tile(const Scene& scene, const TileRect& rect, const PassSamples& samples, uint32_t seed, FilmTile& tile);
 
 /// Renders the scene's crop window with settings.spp samples per pixel.
 Film render(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress = {},

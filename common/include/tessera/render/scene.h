@@ -4,6 +4,7 @@
 
 #include "tessera/accel/bvh.h"
 #include "tessera/core/sampling.h"
+#include "tessera/guiding/spatial_tree.h"
 #include "tessera/light/light_sampler.h"
 #include "tessera/render/bsdf.h"
 #include "tessera/render/camera.h"
@@ -14,6 +15,7 @@
 #include "tessera/render/texture.h"
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,6 +39,8 @@ struct IntegratorSettings {
   // How next-event estimation picks a light (light/light_sampler.h); read by Scene::finalize.
   LightSelection light_selection = LightSelection::Bvh;
   SamplingStrategy strategy = SamplingStrategy::Mis;  // path/volpath only; not read from scene files
+  /// Set by a `guided_path` integrator: the scene asks for path guiding with these settings.
+  std::optional<GuidingSettings> guiding;
 };
 
 enum class SamplerType { Sobol, Independent };

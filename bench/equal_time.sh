@@ -1,0 +1,94 @@
+#!/usr/bin/env bash
+# Path guiding and adaptive sampling at equal time (docs/performance.md, "Guiding and adaptive
+# sampling"): every shared scene at its reference's resolution, each configuration rendered with the
+# same spp and several seeds; per run the render's seconds, its relMSE against ../shared/references/,
+# the same without the worst 0.1% of pixels, and the reference's own noise floor (what relMSE gains
+# from the reference's noise: `tessera compare --variance`, ref_floor). Per scene and configuration
+# the medians over seeds, and the relMSE at the plain render's median time, taking the error above
+# the floor to fall as 1/time (the estimators are unbiased):
+#   equal-time relMSE = floor + (relMSE - floor) * seconds / plain's seconds
+# Writes OUT/equal_time.csv (every run) and OUT/equal_time.md (the table), and prints the table.
+#
+# Usage: bench/equal_time.sh [BUILD_DIR] [SPP]      (defaults: build, 128)
+# Environment: ET_SCENES="cornell-box ..." (default all seven)  ET_SEEDS="1 2 3"
+#   ET_CONFIGS="plain adaptive guided guided+adaptive"  ET_THREADS=2  ET_OUT=docs/performance
+#   TESSERA=path/to/tessera (default BUILD_DIR/cli/tessera)
+# A missing scene or reference is an error (exit 1), never a skip.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build=${1:-build}
+spp=${2:-128}
+tessera=${TESSERA:-$build/cli/tessera}
+shared=../shared
+scenes=(${ET_SCENES:-cornell-box veach-mis veach-bidir living-room bathroom kitchenette staircase2})
+seeds=(${ET_SEEDS:-1 2 3})
+configs=(${ET_CONFIGS:-plain adaptive guided guided+adaptive})
+threads=${ET_THREADS:-2}
+out=${ET_OUT:-docs/performance}
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+
+[ -x "$tessera" ] || { echo "equal_time.sh: no tessera binary at $tessera" >&2; exit 1; }
+for s in "${scenes[@]}"; do
+  for f in scenes/$s/scene.xml references/$s/reference.exr references/$s/variance.exr references/$s/README.md; do
+    [ -f "$shared/$f" ] || { echo "equal_time.sh: missing $shared/$f" >&2; exit 1; }
+  done
+done
+mkdir -p "$out"
+csv="$out/equal_time.csv"
+echo "scene,config,seed,spp,seconds,rel_mse,rel_mse_trim,ref_floor" > "$csv"
+
+for s in "${scenes[@]}"; do
+  res=$(grep -o 'Resolution [0-9]*×[0-9]*' "$shared/references/$s/README.md" | grep -o '[0-9][0-9]*')
+  w=$(echo "$res" | sed -n 1p); h=$(echo "$res" | sed -n 2p)
+  extra=()
+  # Its reference was rendered with `path`; its sky is seen through window glass (docs/performance.md).
+  [ "$s" = kitchenette ] && extra=(--integrator path --allow-unsupported)
+  for seed in "${seeds[@]}"; do
+    for c in "${configs[@]}"; do
+      guiding=off adaptive=off
+      case "$c" in
+        plain) ;; adaptive) adaptive=on ;; guided) guiding=on ;; guided+adaptive) guiding=on adaptive=on ;;
+        *) echo "equal_time.sh: unknown configuration '$c'" >&2; exit 1 ;;
+      esac
+      "$tessera" render "$shared/scenes/$s/scene.xml" "${extra[@]}" --width "$w" --height "$h" --spp "$spp" \
+        --seed "$seed" --threads "$threads" --guiding "$guiding" --adaptive "$adaptive" -q -o "$tmp/img.exr" \
+        2> "$tmp/log"
+      secs=$(grep -o 'render [0-9.e+-]* s' "$tmp/log" | tail -1 | awk '{print $2}')
+      cmp=$("$tessera" compare "$tmp/img.exr" "$shared/references/$s/reference.exr" \
+        --variance "$shared/references/$s/variance.exr")
+      field() { echo "$cmp" | grep -o " $1=[^ ]*" | cut -d= -f2; }
+      echo "$s,$c,$seed,$spp,$secs,$(field rel_mse),$(field rel_mse_trim),$(field ref_floor)" | tee -a "$csv" >&2
+    done
+  done
+done
+
+python3 - "$csv" "$out/equal_time.md" <<'PY'
+import csv, statistics, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+med = lambda xs: statistics.median(xs)
+runs = {}
+for r in rows:
+    runs.setdefault((r["scene"], r["config"]), []).append(r)
+lines = ["| scene | configuration | seconds | relMSE | relMSE, worst 0.1% left out | reference floor | "
+         "relMSE at plain's time | against plain |", "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+for scene in dict.fromkeys(r["scene"] for r in rows):
+    plain = runs.get((scene, "plain"))
+    t_plain = med([float(r["seconds"]) for r in plain]) if plain else None
+    e_plain = None
+    for (sc, config), rs in runs.items():
+        if sc != scene:
+            continue
+        t = med([float(r["seconds"]) for r in rs])
+        floor = float(rs[0]["ref_floor"])
+        # Per seed, then the median: each seed's error scaled to plain's median time.
+        eq = med([floor + (float(r["rel_mse"]) - floor) * float(r["seconds"]) / t_plain for r in rs]) if t_plain else None
+        if config == "plain":
+            e_plain = eq
+        ratio = "%.2f" % (eq / e_plain) if eq is not None and e_plain else ""
+        lines.append("| %s | %s | %.2f | %.4g | %.4g | %.2g | %s | %s |" % (
+            scene, config, t, med([float(r["rel_mse"]) for r in rs]), med([float(r["rel_mse_trim"]) for r in rs]),
+            floor, "%.4g" % eq if eq is not None else "", ratio))
+open(sys.argv[2], "w").write("\n".join(lines) + "\n")
+print("\n".join(lines))
+PY
