@@ -25,16 +25,6 @@ RenderSettings guided_adaptive(int spp, uint32_t seed) {
   return s;
 }
 
-/// The scene `xml` with each of `edits` (exact text, replacement) applied once.
-std::unique_ptr<Scene> load_edited(std::string xml, const std::vector<std::pair<std::string, std::string>>& edits) {
-  for (const auto& [from, to] : edits) {
-    const size_t at = xml.find(from);
-    EXPECT_NE(at, std::string::npos) << from;
-    if (at != std::string::npos) xml.replace(at, from.size(), to);
-  }
-  return load_scene(parse_scene_string(xml, "hard_guided.xml"), LoadOptions{}).scene;
-}
-
 // Compares a guided + adaptive render with a plain one. Four cases here, 13 regions, 3 channels:
 // 156 z-tests at |z| < 4, significance 0.01 (Bonferroni).
 void expect_agrees(const Scene& scene, const RenderSettings& settings, const std::string& what) {

@@ -11,9 +11,14 @@
 #include "tessera/scene/load_context.h"
 #include "tessera/scene/scene_desc.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <memory>
 #include <optional>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace tessera::test {
 
@@ -183,6 +188,21 @@ inline std::unique_ptr<Scene> window_scene() {
 inline std::unique_ptr<Scene> fog_scene() {
   LoadResult r = load_scene(parse_scene_string(kFogScene, "fog_scene.xml"), LoadOptions{});
   return std::move(r.scene);
+}
+
+/// The scene `xml` with each of `edits` (exact text, replacement) applied once, at its film size or
+/// width x height when given.
+inline std::unique_ptr<Scene> load_edited(std::string xml, const std::vector<std::pair<std::string, std::string>>& edits,
+                                          int width = 0, int height = 0) {
+  for (const auto& [from, to] : edits) {
+    const size_t at = xml.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) xml.replace(at, from.size(), to);
+  }
+  LoadOptions options;
+  options.width = width;
+  options.height = height;
+  return load_scene(parse_scene_string(xml, "edited.xml"), options).scene;
 }
 
 }  // namespace tessera::test

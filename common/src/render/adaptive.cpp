@@ -17,28 +17,6 @@ PassSamples PassSamples::uniform(const TileRect& rect, uint32_t begin, uint32_t 
   return s;
 }
 
-PassSamples PassSamples::crop(const TileRect& r) const {
-  TESSERA_CHECK(rect.contains(r));
-  PassSamples out;
-  out.rect = r;
-  out.first.reserve(size_t(r.area()));
-  out.count.reserve(size_t(r.area()));
-  for (int y = r.y0; y < r.y1; ++y)
-    for (int x = r.x0; x < r.x1; ++x) {
-      out.first.push_back(first[index({x, y})]);
-      out.count.push_back(count[index({x, y})]);
-    }
-  return out;
-}
-
-uint64_t PassSamples::samples(const TileRect& r) const {
-  TESSERA_CHECK(rect.contains(r));
-  uint64_t n = 0;
-  for (int y = r.y0; y < r.y1; ++y)
-    for (int x = r.x0; x < r.x1; ++x) n += count[index({x, y})];
-  return n;
-}
-
 bool adaptive_pass(uint32_t begin, uint32_t spp, uint64_t fewest_film_samples, const AdaptiveSettings& s) {
   return fewest_film_samples >= s.min_samples && double(begin) >= s.uniform_fraction * double(spp);
 }
@@ -76,7 +54,7 @@ std::vector<double> neighbour_weights(const std::vector<double>& v, int width, i
     for (int x = 0; x < width; ++x) {
       double sum = 0;
       int n = 0;
-      for (const auto [dx, dy] : {std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}})
+      for (const auto& [dx, dy] : {std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}})
         if (x + dx >= 0 && x + dx < width && y + dy >= 0 && y + dy < height) {
           sum += v[size_t(y + dy) * width + x + dx];
           ++n;
@@ -89,22 +67,22 @@ std::vector<double> neighbour_weights(const std::vector<double>& v, int width, i
 /// Gives `budget` samples to the pixels `which`: each is filled up to c * weight, at most `cap`
 /// more, c found by bisection in a fixed number of steps; the last few samples go in pixel order
 /// so the total is exact.
-void fill_pixels(const std::vector<size_t>& which, std::vector<double> weight, const std::vector<uint64_t>& have,
+void fill_pixels(const std::vector<size_t>& which, const std::vector<double>& weight, const std::vector<uint64_t>& have,
                  uint64_t cap, uint64_t budget, std::vector<uint32_t>& count) {
   // A pixel without variance (so far) still takes samples once every other pixel has its share.
+  double raw_sum = 0;
+  for (size_t i : which) raw_sum += weight[i];
+  const double least = raw_sum > 0 ? 1e-3 * raw_sum / double(which.size()) : 1.0;
+  const auto weight_of = [&](size_t i) { return std::max(weight[i], least); };
   double weight_sum = 0, have_sum = 0;
-  for (size_t i : which) weight_sum += weight[i];
-  const double least = weight_sum > 0 ? 1e-3 * weight_sum / double(which.size()) : 1.0;
-  weight_sum = 0;
   for (size_t i : which) {
-    weight[i] = std::max(weight[i], least);
-    weight_sum += weight[i];
+    weight_sum += weight_of(i);
     have_sum += double(have[i]);
   }
   const auto fill = [&](double c, std::vector<uint32_t>* out) {
     uint64_t total = 0;
     for (size_t i : which) {
-      const double target = std::floor(c * weight[i]);
+      const double target = std::floor(c * weight_of(i));
       const double more = target > double(have[i]) ? std::min(target - double(have[i]), double(cap)) : 0.0;
       if (out) (*out)[i] = uint32_t(more);
       total += uint64_t(more);

@@ -81,7 +81,6 @@ void render_tile_with(const Scene& scene, const Integrator& integrator, const Fi
 
 void render_tile(const Scene& scene, const TileRect& rect, uint32_t sample_begin, uint32_t sample_end,
                  uint32_t seed, FilmTile& tile) {
-  auto integrator = make_integrator(scene.integrator);
   render_tile(scene, rect, PassSamples::uniform(rect, sample_begin, sample_end), seed, tile);
 }
 

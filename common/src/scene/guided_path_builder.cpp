@@ -44,8 +44,7 @@ void read_budget(BuildState& st, const SceneNode& node) {
   if (choice(node, type_name, "seconds", {"spp", "seconds"}) == "seconds")
     throw SceneError(node.loc_of(type_name), node.describe() + ": budgetType \"seconds\" would make the image depend on the "
                                                                "machine; use \"spp\" (budget = samples per pixel)");
-  const std::string budget = name_in(node, "budget", "budget");
-  if (node.peek(budget)) st.spp_budget = int(number_in(node, budget, 1, 1, double(1 << 24), false));
+  if (node.peek("budget")) st.spp_budget = int(number_in(node, "budget", 1, 1, double(1 << 24), false));
 }
 
 void read_combination(BuildState& st, const SceneNode& node, GuidingSettings& g) {
@@ -74,9 +73,8 @@ void read_filters_and_loss(BuildState& st, const SceneNode& node, GuidingSetting
 }
 
 void read_notes(BuildState& st, const SceneNode& node) {
-  const std::string nee = name_in(node, "nee", "nee");
-  if (choice(node, nee, "never", {"never", "kickstart", "always"}) != "always")
-    st.ctx.note(node.loc_of(nee), node.describe() + ": Tessera always uses next-event estimation where it can "
+  if (choice(node, "nee", "never", {"never", "kickstart", "always"}) != "always")
+    st.ctx.note(node.loc_of("nee"), node.describe() + ": Tessera always uses next-event estimation where it can "
                                                     "(the same expected image)");
   const std::string per_pass = name_in(node, "spp_per_pass", "sppPerPass");
   if (node.peek(per_pass) && node.get_int(per_pass, 4) > 0)

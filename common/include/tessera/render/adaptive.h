@@ -50,10 +50,6 @@ struct PassSamples {
   /// Every pixel of `rect` takes [begin, end).
   static PassSamples uniform(const TileRect& rect, uint32_t begin, uint32_t end);
   size_t index(Vec2i p) const { return size_t(p.y - rect.y0) * size_t(rect.width()) + size_t(p.x - rect.x0); }
-  /// The part over `r` (inside rect).
-  PassSamples crop(const TileRect& r) const;
-  /// Samples of the pixels of `r` (inside rect).
-  uint64_t samples(const TileRect& r) const;
   bool operator==(const PassSamples&) const = default;
 };
 
