@@ -2,13 +2,16 @@
 # The farm's cost against a local render: wall time of the Cornell box through a coordinator with
 # 1 and 2 local workers vs `tessera render` on the same cores, the coordinator's CPU time per work
 # unit, and the bytes a unit's result takes on the wire. Checks the images are bit-identical.
-# Usage: bench/farm_overhead.sh [BUILD_DIR] [SPP] [SIZE] [TILE]
+# With ADAPTIVE=on, both render with --adaptive on, and the time the coordinator spent deciding the
+# adaptive passes' counts at their barriers is printed too.
+# Usage: bench/farm_overhead.sh [BUILD_DIR] [SPP] [SIZE] [TILE] [ADAPTIVE]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build}
 spp=${2:-256}
 size=${3:-256}
 tile=${4:-32}
+adaptive=${5:-off}
 scene=../shared/scenes/cornell-box/scene.xml
 cores=$(nproc)
 tmp=$(mktemp -d)
@@ -17,9 +20,9 @@ now() { date +%s.%N; }
 
 t0=$(now)
 "$build/cli/tessera" render "$scene" --spp "$spp" --width "$size" --height "$size" --tile-size "$tile" -q \
-    -o "$tmp/local.exr" 2> /dev/null
+    --adaptive "$adaptive" -o "$tmp/local.exr" 2> /dev/null
 local_s=$(echo "$(now) - $t0" | bc -l)
-printf "cornell %dx%d %d spp, %d cores, tile %d\n" "$size" "$size" "$spp" "$cores" "$tile"
+printf "cornell %dx%d %d spp, %d cores, tile %d, adaptive %s\n" "$size" "$size" "$spp" "$cores" "$tile" "$adaptive"
 printf "%-28s %8.2f s\n" "tessera render ($cores threads)" "$local_s"
 
 for workers in 1 2; do
@@ -35,7 +38,7 @@ for workers in 1 2; do
   read -r u0 s0 < <(awk '{print $14, $15}' "/proc/$server/stat")
   t0=$(now)
   "$build/cli/tessera" submit "$scene" --server "$url" --spp "$spp" --width "$size" --height "$size" \
-      --tile-size "$tile" -q -o "$data/farm.exr" 2> /dev/null > /dev/null
+      --tile-size "$tile" --adaptive "$adaptive" -q -o "$data/farm.exr" 2> /dev/null > /dev/null
   wall=$(echo "$(now) - $t0" | bc -l)
   read -r u1 s1 < <(awk '{print $14, $15}' "/proc/$server/stat")
   status=$(curl -sf "$url/api/v1/jobs/1")
@@ -48,4 +51,9 @@ for workers in 1 2; do
   printf "%-28s %8.2f s  (%.2fx local)  %d units, coordinator CPU %.2f ms/unit, result %.0f + lease %.0f bytes/unit, %s\n" \
       "farm, $workers local worker(s) x $threads" "$wall" "$(echo "$wall / $local_s" | bc -l)" "$units" \
       "$(echo "1000 * $cpu / $units" | bc -l)" "$(echo "$bytes / $units" | bc -l)" "$(echo "$lbytes / $units" | bc -l)" "$same"
+  planned=$(grep -o 'job.pass_planned.*' "$data/server.log" | grep -o 'seconds=[0-9.e-]*' | cut -d= -f2 || true)
+  if [ -n "$planned" ]; then
+    printf "%-28s %d adaptive passes planned at barriers in %.1f ms in all\n" "" "$(echo "$planned" | wc -l)" \
+        "$(echo "$planned" | awk '{s += $1} END {print 1000 * s}')"
+  fi
 done

@@ -147,6 +147,8 @@ int run_submit(const SubmitOptions& o) {
   settings.integrator = o.integrator;
   settings.light_selection = o.light_selection;
   settings.target_error = o.target_error;
+  settings.adaptive = o.adaptive == "on";
+  if (!o.guiding.empty()) settings.guiding = o.guiding == "on";
   settings.webhook = o.webhook;
 
   std::string bundle;

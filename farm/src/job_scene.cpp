@@ -39,12 +39,14 @@ LoadedJobScene load_job_scene(const std::string& bundle_dir, const std::string& 
 JobPlan make_job_plan(const std::string& bundle_dir, const std::string& scene_file, const JobSettings& settings,
                       const LoadedJobScene& scene) {
   const Scene& s = *scene.loaded.scene;
-  // The farm does not guide yet: rendering such a scene unguided would give another image than
+  // The farm does not guide yet: rendering such a job unguided would give another image than
   // `tessera render` does with the same flags.
-  if (s.integrator.guiding)
-    throw SceneError(FileLoc{scene_file, 0}, "the scene's guided_path integrator asks for path guiding, which the farm "
-                                             "does not do yet; render it with `tessera render`, or submit it with "
-                                             "--integrator path");
+  if (settings.guiding.value_or(s.integrator.guiding.has_value()))
+    throw SceneError(FileLoc{scene_file, 0},
+                     std::string(settings.guiding ? "the job asks for path guiding" :
+                                                    "the scene's guided_path integrator asks for path guiding") +
+                         ", which the farm does not do yet; render it with `tessera render`, or submit it with "
+                         "--guiding off");
   JobPlan plan;
   plan.settings = settings;
   plan.settings.spp = s.sampler.sample_count;
@@ -81,7 +83,10 @@ TileResult render_lease(const Scene& scene, const Lease& lease) {
   TileResult result;
   begin_tile_result(lease, result);
   const auto t0 = std::chrono::steady_clock::now();
-  render_tile(scene, lease.rect, lease.sample_begin, lease.sample_end, lease.settings.seed, result.film);
+  if (lease.samples.count.empty())
+    render_tile(scene, lease.rect, lease.sample_begin, lease.sample_end, lease.settings.seed, result.film);
+  else
+    render_tile(scene, lease.rect, lease.samples, lease.settings.seed, result.film);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return result;
 }

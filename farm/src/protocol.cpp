@@ -30,7 +30,10 @@ class Fields {
       return;
     }
     try {
-      if constexpr (std::is_integral_v<T>) {
+      if constexpr (std::is_same_v<T, bool>) {
+        if (!it->is_boolean()) throw std::invalid_argument("true or false");
+        out = it->template get<bool>();
+      } else if constexpr (std::is_integral_v<T>) {
         if (!it->is_number_integer()) throw std::invalid_argument("an integer");
         const bool in_range =
             it->is_number_unsigned()
@@ -53,6 +56,14 @@ class Fields {
     } catch (const std::exception& e) {
       fail(std::string(what_) + ": field '" + name + "' must be " + e.what());
     }
+  }
+  /// Absent or null leaves `out` empty.
+  template <class T>
+  void get(const char* name, std::optional<T>& out) {
+    T value{};
+    const bool present = j_.is_object() && j_.contains(name) && !j_[name].is_null();
+    get(name, value);
+    if (present && ok()) out = value;
   }
   void get_strings(const char* name, std::map<std::string, std::string>& out) {
     seen_.insert(name);
@@ -101,7 +112,8 @@ json to_json(const JobSettings& s) {
             {"spp", s.spp},     {"width", s.width},         {"height", s.height},
             {"seed", s.seed},   {"tile_size", s.tile_size}, {"priority", s.priority},
             {"defines", s.defines}, {"integrator", s.integrator}, {"light_selection", s.light_selection},
-            {"target_error", s.target_error}, {"webhook", s.webhook}};
+            {"target_error", s.target_error}, {"adaptive", s.adaptive}, {"webhook", s.webhook}};
+  j["guiding"] = s.guiding ? json(*s.guiding) : json(nullptr);
   return j;
 }
 
@@ -173,6 +185,8 @@ bool job_settings_from_json(const json& j, JobSettings& out, std::string& error,
   f.get("integrator", out.integrator);
   f.get("light_selection", out.light_selection);
   f.get("target_error", out.target_error);
+  f.get("adaptive", out.adaptive);
+  f.get("guiding", out.guiding);
   f.get("webhook", out.webhook);
   f.finish();
   if (!f.ok()) return false;
@@ -226,14 +240,35 @@ namespace {
 
 // A lease's fields split in two: its own, and its job's (the same in every lease of the job).
 json lease_own_json(const Lease& l) {
-  return {{"id", l.id},
-          {"job", l.job_id},
-          {"tile", l.tile},
-          {"pass", l.pass},
-          {"rect", {l.rect.x0, l.rect.y0, l.rect.x1, l.rect.y1}},
-          {"sample_begin", l.sample_begin},
-          {"sample_end", l.sample_end},
-          {"seconds_to_expiry", l.seconds_to_expiry}};
+  json j = {{"id", l.id},
+            {"job", l.job_id},
+            {"tile", l.tile},
+            {"pass", l.pass},
+            {"rect", {l.rect.x0, l.rect.y0, l.rect.x1, l.rect.y1}},
+            {"sample_begin", l.sample_begin},
+            {"sample_end", l.sample_end},
+            {"seconds_to_expiry", l.seconds_to_expiry}};
+  if (!l.samples.count.empty()) {
+    j["first"] = l.samples.first;
+    j["count"] = l.samples.count;
+  }
+  return j;
+}
+
+// An adaptive lease's per-pixel samples: both arrays, one entry per pixel of the rectangle.
+bool lease_samples_valid(const Lease& l, std::string& error) {
+  const size_t n = size_t(l.rect.area());
+  if (l.samples.first.empty() && l.samples.count.empty()) return true;
+  if (l.samples.first.size() != n || l.samples.count.size() != n) {
+    error = "lease: 'first' and 'count' must have one entry per pixel of 'rect' (" + std::to_string(n) + ")";
+    return false;
+  }
+  for (size_t i = 0; i < n; ++i)
+    if (l.samples.count[i] > (1u << 16) || l.samples.first[i] > UINT32_MAX - l.samples.count[i]) {
+      error = "lease: pixel " + std::to_string(i) + " has an implausible sample range";
+      return false;
+    }
+  return true;
 }
 
 json lease_job_json(const Lease& l) {
@@ -267,6 +302,8 @@ bool lease_from_json(const json& j, Lease& out, std::string& error) {
   f.get("rect", rect, true);
   f.get("sample_begin", out.sample_begin, true);
   f.get("sample_end", out.sample_end, true);
+  f.get("first", out.samples.first);
+  f.get("count", out.samples.count);
   f.get("seconds_to_expiry", out.seconds_to_expiry);
   f.get("settings", settings, true);
   f.get("scene_file", out.scene_file, true);
@@ -282,6 +319,8 @@ bool lease_from_json(const json& j, Lease& out, std::string& error) {
     error = "lease: empty rectangle or sample range";
     return false;
   }
+  out.samples.rect = out.rect;
+  if (!lease_samples_valid(out, error)) return false;
   return job_settings_from_json(settings, out.settings, error);
 }
 

@@ -3,6 +3,7 @@
 #include "disk_full.h"
 #include "event_log.h"
 
+#include "tessera/farm/sample_counts.h"
 #include "tessera/farm/tile_result.h"
 #include "tessera/image/image.h"
 
@@ -84,6 +85,7 @@ Coordinator::Coordinator(CoordinatorOptions options) : impl_(std::make_unique<Im
       continue;
     }
     JobState& job = *s.jobs.emplace(row.id, s.rebuild_job(row)).first->second;
+    s.save_pass_plans(job);
     passes += job.done_units();
     if (!is_terminal(job.phase) && job.complete()) {  // its last result landed before a crash
       (void)s.change_phase(job, JobPhase::Done);
@@ -167,6 +169,15 @@ std::unique_ptr<JobState> Coordinator::Impl::job_from_row(const JobRow& row) con
 std::unique_ptr<JobState> Coordinator::Impl::rebuild_job(const JobRow& row) {
   auto job = job_from_row(row);
   const std::string where = "job " + std::to_string(row.id) + ": ";
+  job->begin_rebuild();
+  // An adaptive job's decided passes first: its results are checked against them.
+  store.for_each_pass_plan(row.id, [&](uint32_t pass, std::string&& data) {
+    std::vector<uint32_t> counts;
+    std::string err;
+    if (!decode_sample_counts(data, size_t(job->plan().window.area()), counts, err) ||
+        !job->restore_pass_plan(pass, std::move(counts), err))
+      throw std::runtime_error(where + err);
+  });
   // Each tile's checkpoint first, then the passes after it, in pass order: the film's sums as they were.
   store.for_each_checkpoint(row.id, [&](CheckpointRow&& c) {
     TileResult sums;
@@ -181,6 +192,8 @@ std::unique_ptr<JobState> Coordinator::Impl::rebuild_job(const JobRow& row) {
   store.for_each_result(row.id, [&](ResultRow&& r) {
     if (r.tile >= job->num_tiles() || r.pass >= job->num_passes()) return;
     const size_t unit = job->unit(r.tile, r.pass);
+    if (!job->pass_decided(r.pass))
+      throw std::runtime_error(where + "a result of pass " + std::to_string(r.pass) + " without its stored sample counts");
     if (r.data.empty() || r.pass < job->passes_in_film(r.tile))
       return job->mark_done(unit, r.worker);  // (held by its tile's checkpoint)
     TileResult result;
@@ -188,6 +201,7 @@ std::unique_ptr<JobState> Coordinator::Impl::rebuild_job(const JobRow& row) {
     if (!decode_tile_result(r.data, result, err)) throw std::runtime_error(where + "stored result is corrupt: " + err);
     (void)job->add_result(unit, std::move(result.film), r.worker);
   });
+  job->end_rebuild();
   return job;
 }
 
@@ -202,6 +216,18 @@ std::string encode_checkpoint(uint64_t job, const JobState::Checkpoint& cp) {
   // compressing (even zstd's fastest mode) took a third of that writer's time to save a fifth of
   // the bytes (sums are noise in their low bits). One per tile is within the storage bound as is.
   return encode_tile_result(sums, kUncompressed);
+}
+
+void Coordinator::Impl::save_pass_plans(JobState& job) {
+  for (JobState::DecidedPass& d : job.take_new_plans()) {
+    log_event(spdlog::level::info, "job.pass_planned", {{"job", job.id()}, {"pass", d.pass}, {"seconds", d.seconds}});
+    // Retried until stored, ahead of the leases appended after it: a lease of the pass is only
+    // handed out once its counts are durable.
+    auto counts = std::make_shared<const std::vector<uint32_t>>(std::move(d.counts));
+    (void)commits.append([id = job.id(), pass = d.pass, counts](Store& st) {
+      st.save_pass_plan(id, pass, encode_sample_counts(*counts));
+    }, GroupCommit::Retry::UntilDurable);
+  }
 }
 
 void Coordinator::Impl::checkpoint_tile(JobState& job, uint32_t tile, uint32_t min_new) {

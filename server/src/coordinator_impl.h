@@ -125,6 +125,8 @@ struct Coordinator::Impl {
   /// Under `mu`: appends the tile's checkpoint once `min_new` more passes are in its film (encoded
   /// by the writer, not under `mu`).
   void checkpoint_tile(JobState& job, uint32_t tile, uint32_t min_new);
+  /// Under `mu`: appends the adaptive passes the job decided since the last call to the store.
+  void save_pass_plans(JobState& job);
   /// Not under `mu`: waits for a group-commit ticket; the error (500/507) if its batch failed.
   Status durable(uint64_t ticket);
   /// Under `mu`: a second result for a done unit is dropped, and compared with the first when its

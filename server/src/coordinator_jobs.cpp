@@ -456,6 +456,7 @@ Status Coordinator::retry_job(uint64_t id) {
   if (it == s.jobs.end()) return unknown_job(id);
   if (it->second->phase != JobPhase::Failed && it->second->phase != JobPhase::Cancelled)
     return not_ended(it->second->phase);  // (retried by another request meanwhile)
+  s.save_pass_plans(*job);
   const uint64_t ticket = s.change_phase(*job, JobPhase::Queued);
   it->second = std::move(job);
   lock.unlock();

@@ -128,6 +128,7 @@ Coordinator::Impl::IssuedLease Coordinator::Impl::issue_lease(uint64_t worker, W
   l.rect = job.rect(unit);
   l.sample_begin = job.sample_begin(unit);
   l.sample_end = job.sample_end(unit);
+  if (std::optional<PassSamples> samples = job.lease_samples(unit)) l.samples = std::move(*samples);
   l.seconds_to_expiry = opt.heartbeat_interval * kMissedHeartbeats;
   l.settings = job.plan().settings;
   l.scene_file = job.plan().scene_file;
@@ -249,6 +250,10 @@ Result<size_t> Coordinator::Impl::check_result(uint64_t worker, const TileResult
   if (!(result.film.rect() == job.rect(unit)) || result.sample_begin != job.sample_begin(unit) ||
       result.sample_end != job.sample_end(unit))
     return make_error(Code::BadRequest, "bad_result", "the result's rectangle or samples do not match the unit");
+  // (A late copy of a done unit is answered as a duplicate, its sums compared with the accepted ones.)
+  if (!job.is_done(unit) && !job.result_fits(unit, result.film))
+    return make_error(Code::BadRequest, "bad_result",
+                      "the result's per-pixel sample counts are not those its adaptive pass gives the tile");
   return unit;
 }
 
@@ -264,6 +269,7 @@ void Coordinator::Impl::result_committed(bool durable, uint64_t job_id, size_t u
   }
   const uint64_t samples = job.unit_samples(unit);
   if (!job.add_result(unit, std::move(result.film), worker)) return;  // (a retry rebuilt it meanwhile)
+  save_pass_plans(job);
   checkpoint_tile(job, job.tile_of(unit), 1);
   job.result_bytes += bytes;
   ++counters.done;

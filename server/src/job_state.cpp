@@ -2,6 +2,7 @@
 
 #include "tessera/render/renderer.h"
 
+#include <chrono>
 #include <limits>
 
 namespace tessera::server {
@@ -45,7 +46,35 @@ JobState::JobState(uint64_t id, JobPlan plan, std::string name, int priority, do
   tile_counters_.assign(tiles_.size(), RenderCounters{});
   total_samples_ = uint64_t(plan_.window.area()) * uint64_t(plan_.settings.spp);
   pass_done_.assign(passes_.size(), 0);
-  open_passes_ = plan_.settings.target_error > 0 ? std::min<size_t>(1, passes_.size()) : passes_.size();
+  if (plan_.settings.adaptive)
+    plans_.emplace(plan_.window, tiles_, passes_, pass_begin_, uint32_t(plan_.settings.spp));
+  open_passes_ = plan_.settings.target_error > 0 ? std::min<size_t>(1, passes_.size())
+                 : plans_                        ? plans_->first_barrier()
+                                                 : passes_.size();
+}
+
+uint64_t JobState::unit_samples(size_t unit) const {
+  const uint32_t pass = pass_of(unit);
+  if (plans_ && plans_->at_barrier(pass) && plans_->decided(pass)) return plans_->samples(tile_of(unit), pass);
+  return uint64_t(rect(unit).area()) * (sample_end(unit) - sample_begin(unit));
+}
+
+std::optional<PassSamples> JobState::lease_samples(size_t unit) const {
+  if (!plans_ || !plans_->at_barrier(pass_of(unit))) return std::nullopt;
+  return plans_->tile_samples(tile_of(unit), pass_of(unit));
+}
+
+bool JobState::result_fits(size_t unit, const FilmTile& film) const {
+  if (!plans_ || !plans_->at_barrier(pass_of(unit))) return true;
+  return plans_->matches(tile_of(unit), pass_of(unit), film);
+}
+
+bool JobState::restore_pass_plan(uint32_t pass, std::vector<uint32_t> counts, std::string& error) {
+  if (!plans_) {
+    error = "stored sample counts for a job that is not adaptive";
+    return false;
+  }
+  return plans_->restore(pass, std::move(counts), error);
 }
 
 Image JobState::image() const {
@@ -66,15 +95,32 @@ NoiseEstimate JobState::noise() const {
   return *noise_;
 }
 
+// A unit of the pass is done, or its adaptive counts are known: going on to it was decided
+// before a restart.
+bool JobState::pass_decided_before(uint32_t pass) const {
+  if (plans_ && plans_->at_barrier(pass) && plans_->decided(pass)) return true;
+  for (size_t t = 0; t < tiles_.size(); ++t)
+    if (is_done(unit(uint32_t(t), pass))) return true;
+  return false;
+}
+
+// The one place passes open. A barrier (target error, or an adaptive pass) is passed only once
+// every tile has every pass before it, when the film holds exactly those passes.
 void JobState::advance_passes() {
   while (complete_passes_ < passes_.size() && pass_done_[complete_passes_] == tiles_.size()) ++complete_passes_;
-  while (!converged_ && open_passes_ < passes_.size() && complete_passes_ >= open_passes_) {
-    // A unit of the next pass is done already: the decision to go on was taken before a restart.
-    bool decided = false;
-    for (size_t t = 0; t < tiles_.size() && !decided; ++t) decided = is_done(unit(uint32_t(t), uint32_t(open_passes_)));
-    if (!decided && film_ && noise().rel_mse <= plan_.settings.target_error) {
+  while (!rebuilding_ && !converged_ && open_passes_ < passes_.size() && complete_passes_ >= open_passes_) {
+    const uint32_t p = uint32_t(open_passes_);
+    const bool decided = pass_decided_before(p);
+    if (!decided && film_ && plan_.settings.target_error > 0 && noise().rel_mse <= plan_.settings.target_error) {
       converged_ = true;
       break;
+    }
+    if (plans_ && plans_->at_barrier(p) && !plans_->decided(p)) {
+      if (!film_) break;  // (released: the job has ended)
+      const auto t0 = std::chrono::steady_clock::now();
+      plans_->decide(p, *film_);
+      new_plans_.push_back({p, plans_->latest_counts(),
+                            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()});
     }
     ++open_passes_;
   }

@@ -4,6 +4,7 @@
 
 #include "tessera/farm/job_scene.h"
 #include "tessera/farm/sha256.h"
+#include "pass_plans.h"
 #include "tessera/image/image.h"
 #include "tessera/render/film.h"
 #include "tessera/render/noise_estimate.h"
@@ -44,8 +45,8 @@ class JobState {
   const TileRect& rect(size_t unit) const { return tiles_[tile_of(unit)]; }
   uint32_t sample_begin(size_t unit) const { return pass_begin_[pass_of(unit)]; }
   uint32_t sample_end(size_t unit) const { return pass_begin_[pass_of(unit)] + passes_[pass_of(unit)]; }
-  /// Samples (pixels x samples per pixel) of the unit: the weight of its work.
-  uint64_t unit_samples(size_t unit) const { return uint64_t(rect(unit).area()) * (sample_end(unit) - sample_begin(unit)); }
+  /// Samples of the unit (pixels x samples per pixel, or an adaptive pass's counts): its work.
+  uint64_t unit_samples(size_t unit) const;
   /// The samples the job will render: all of spp, or those done once it stopped at its target.
   uint64_t total_samples() const { return converged_ ? done_samples_ : total_samples_; }
   uint64_t done_samples() const { return done_samples_; }
@@ -67,6 +68,35 @@ class JobState {
   NoiseEstimate noise() const;
   /// A finished job resumed without its film that had stopped at its target.
   void restore_converged() { converged_ = true; }
+
+  // Adaptive sampling (settings.adaptive): passes from PassPlans::first_barrier() open one at a
+  // time, each once every tile has the passes before it, with per-pixel counts decided then from
+  // the film (pass_plans.h). A lease of such a pass carries its tile's counts; a result must hold
+  // exactly them.
+  /// The unit's per-pixel samples when its pass is adaptive (else empty: every pixel takes
+  /// [sample_begin, sample_end)).
+  std::optional<PassSamples> lease_samples(size_t unit) const;
+  /// Whether a result's per-pixel sample counts are those of its unit.
+  bool result_fits(size_t unit, const FilmTile& film) const;
+  /// Whether the pass's samples are decided (its units may exist).
+  bool pass_decided(uint32_t pass) const { return !plans_ || plans_->decided(pass); }
+  struct DecidedPass {
+    uint32_t pass = 0;
+    std::vector<uint32_t> counts;  // row-major over the window
+    double seconds = 0;            // deciding took (at the barrier, under the coordinator's lock)
+  };
+  /// Adaptive passes decided since the last call: stored before any of their units is leased.
+  std::vector<DecidedPass> take_new_plans() { return std::move(new_plans_); }
+  /// Rebuilding: an adaptive pass's stored counts, in pass order, before any result.
+  [[nodiscard]] bool restore_pass_plan(uint32_t pass, std::vector<uint32_t> counts, std::string& error);
+  /// While rebuilding from the store, no pass opens: once every stored result is in (end_rebuild),
+  /// a decision taken before a restart is recognised by its units or stored counts, rather than
+  /// taken again from a film its checkpoints may have filled with later passes.
+  void begin_rebuild() { rebuilding_ = true; }
+  void end_rebuild() {
+    rebuilding_ = false;
+    advance_passes();
+  }
 
   /// The first unit, pass-major, that is neither done nor leased and that `worker` may take.
   std::optional<size_t> next_unit() const;
@@ -148,6 +178,7 @@ class JobState {
     if (film_) (void)noise();  // kept for the finished job's status
     film_.reset();
     film_released_ = true;
+    if (plans_) plans_->release_pixels();
     waiting_.clear();
   }
   const RenderCounters& counters() const { return counters_; }
@@ -187,6 +218,7 @@ class JobState {
   std::map<size_t, FilmTile> waiting_;           // results that arrived before an earlier pass
   std::map<size_t, Sha256Digest> digests_;       // see remember_digest
   void advance_passes();
+  bool pass_decided_before(uint32_t pass) const;
   Checkpoint film_checkpoint(uint32_t tile) const;
 
   size_t done_units_ = 0, first_open_ = 0;
@@ -194,6 +226,9 @@ class JobState {
   size_t open_passes_ = 0;           // passes that may be leased
   size_t complete_passes_ = 0;       // passes every tile has
   bool converged_ = false;
+  std::optional<PassPlans> plans_;  // adaptive jobs
+  std::vector<DecidedPass> new_plans_;
+  bool rebuilding_ = false;
   mutable std::optional<NoiseEstimate> noise_;  // for done_units_ == noise_units_
   mutable size_t noise_units_ = 0;
   uint64_t total_samples_ = 0, done_samples_ = 0;

@@ -26,6 +26,8 @@ CREATE TABLE IF NOT EXISTS workers(id INTEGER PRIMARY KEY AUTOINCREMENT, name TE
   last_seen REAL NOT NULL, state TEXT NOT NULL);
 CREATE TABLE IF NOT EXISTS checkpoints(job INTEGER NOT NULL, tile INTEGER NOT NULL, passes INTEGER NOT NULL,
   data BLOB NOT NULL, PRIMARY KEY(job, tile));
+CREATE TABLE IF NOT EXISTS pass_plans(job INTEGER NOT NULL, pass INTEGER NOT NULL, data BLOB NOT NULL,
+  PRIMARY KEY(job, pass));
 CREATE TABLE IF NOT EXISTS expired_jobs(id INTEGER PRIMARY KEY, name TEXT NOT NULL, expired REAL NOT NULL);
 )";
 
@@ -287,6 +289,18 @@ void Store::for_each_checkpoint(uint64_t job, const std::function<void(Checkpoin
   while (st.step()) fn(CheckpointRow{uint32_t(st.i(0)), uint32_t(st.i(1)), st.s(2)});
 }
 
+void Store::save_pass_plan(uint64_t job, uint32_t pass, const std::string& data) {
+  WriteLock lock(write_mu_);
+  Stmt(db_, prepared("INSERT OR REPLACE INTO pass_plans(job, pass, data) VALUES(?, ?, ?)"))
+      .bind(int64_t(job)).bind(int64_t(pass)).blob(data).step();
+}
+
+void Store::for_each_pass_plan(uint64_t job, const std::function<void(uint32_t, std::string&&)>& fn) {
+  Stmt st(rd_, "SELECT pass, data FROM pass_plans WHERE job = ? ORDER BY pass");
+  st.bind(int64_t(job));
+  while (st.step()) fn(uint32_t(st.i(0)), st.s(1));
+}
+
 void Store::for_each_result(uint64_t job, const std::function<void(ResultRow&&)>& fn, bool with_data) {
   Stmt st(rd_, with_data ? "SELECT tile, pass, worker, data FROM results WHERE job = ? ORDER BY pass, tile"
                          : "SELECT tile, pass, worker, '' FROM results WHERE job = ? ORDER BY pass, tile");
@@ -350,6 +364,7 @@ void Store::delete_job(uint64_t id, double now) {
         .bind(now).bind(int64_t(id)).step();
     Stmt(db_, "DELETE FROM results WHERE job = ?").bind(int64_t(id)).step();
     Stmt(db_, "DELETE FROM checkpoints WHERE job = ?").bind(int64_t(id)).step();
+    Stmt(db_, "DELETE FROM pass_plans WHERE job = ?").bind(int64_t(id)).step();
     Stmt(db_, "DELETE FROM leases WHERE job = ?").bind(int64_t(id)).step();
     Stmt(db_, "DELETE FROM jobs WHERE id = ?").bind(int64_t(id)).step();
   });

@@ -247,7 +247,7 @@ TEST(BundlePlan, RootIsTheDeepestCommonFolder) {
   EXPECT_EQ(alone.files, std::vector<std::string>{"scene.xml"});
 }
 
-TEST(JobPlan, AGuidedPathSceneIsRefusedUntilTheFarmGuides) {
+TEST(JobPlan, AGuidedJobIsRefusedUntilTheFarmGuides) {
   TempDir t;
   std::ofstream(t.path / "scene.xml") << R"(<scene version="0.6.0">
   <integrator type="guided_path"><string name="budgetType" value="spp"/><float name="budget" value="16"/>
@@ -260,11 +260,18 @@ TEST(JobPlan, AGuidedPathSceneIsRefusedUntilTheFarmGuides) {
     ADD_FAILURE() << "no error";
   } catch (const SceneError& e) {
     EXPECT_NE(std::string(e.what()).find("scene.xml"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("--integrator path"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("--guiding off"), std::string::npos) << e.what();
   }
-  settings.integrator = "path";  // what the error suggests
-  EXPECT_NO_THROW(
-      (void)make_job_plan(t.path.string(), "scene.xml", settings, load_job_scene(t.path.string(), "scene.xml", settings)));
+  auto plan = [&] {
+    return make_job_plan(t.path.string(), "scene.xml", settings, load_job_scene(t.path.string(), "scene.xml", settings));
+  };
+  settings.guiding = false;  // what the error suggests
+  EXPECT_NO_THROW((void)plan());
+  settings.guiding.reset();
+  settings.integrator = "path";
+  EXPECT_NO_THROW((void)plan());
+  settings.guiding = true;  // asked for on any scene
+  EXPECT_THROW((void)plan(), SceneError);
 }
 
 }  // namespace

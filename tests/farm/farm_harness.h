@@ -235,6 +235,7 @@ inline Image local_render(const std::string& scene, const JobSettings& settings)
   rs.seed = settings.seed;
   rs.tile_size = 32;  // deliberately not the farm's tile size
   rs.target_error = settings.target_error;
+  rs.adaptive = settings.adaptive;
   return render(*loaded.loaded.scene, rs).to_image();
 }
 

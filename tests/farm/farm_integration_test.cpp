@@ -34,13 +34,18 @@ JobSettings long_job() {
 
 double progress(const nlohmann::json& j) { return j.value("progress", 0.0); }
 
-TEST(FarmIntegration, TwoWorkersStitchTheImageBitForBit) {
-  TESSERA_REQUIRE_FILE(cornell());
-  Farm farm;
+// The coordinator and two local workers, registered.
+bool start_with_two_workers(Farm& farm) {
   farm.start_server();
   farm.add_worker();
   farm.add_worker();
-  ASSERT_TRUE(farm.wait_workers(2));
+  return farm.wait_workers(2);
+}
+
+TEST(FarmIntegration, TwoWorkersStitchTheImageBitForBit) {
+  TESSERA_REQUIRE_FILE(cornell());
+  Farm farm;
+  ASSERT_TRUE(start_with_two_workers(farm));
   const JobSettings settings = small_job();
   client::HttpReply reply;
   uint64_t id = farm.submit(cornell(), settings, &reply);
@@ -63,10 +68,7 @@ TEST(FarmIntegration, TwoWorkersStitchTheImageBitForBit) {
 // worker `lost`.
 double kill_a_worker_at(double at) {
   Farm farm({"--heartbeat-interval", "0.5"});
-  farm.start_server();
-  farm.add_worker();
-  farm.add_worker();
-  EXPECT_TRUE(farm.wait_workers(2));
+  EXPECT_TRUE(start_with_two_workers(farm));
   const JobSettings settings = long_job();
   uint64_t id = farm.submit(cornell(), settings);
   EXPECT_GT(id, 0u);
@@ -111,10 +113,7 @@ TEST(FarmIntegration, KilledCoordinatorResumesWithoutRerenderingAcknowledgedPass
   TESSERA_REQUIRE_FILE(cornell());
   // Without speculative copies every duplicate would be a unit rendered twice for the restart.
   Farm farm({"--no-speculation"});
-  farm.start_server();
-  farm.add_worker();
-  farm.add_worker();
-  ASSERT_TRUE(farm.wait_workers(2));
+  ASSERT_TRUE(start_with_two_workers(farm));
   // Few, slow units (up to 64 samples of 96x96 pixels each): the coordinator is killed while both
   // workers are inside one, so their leases are in flight across the restart.
   JobSettings settings = long_job();
@@ -140,6 +139,29 @@ TEST(FarmIntegration, KilledCoordinatorResumesWithoutRerenderingAcknowledgedPass
   std::printf("coordinator killed at %d/%d units; after restart %d; leases issued %d, re-issued after ack %d\n",
               mid.value("units_done", 0), mid.value("units_total", 0), resumed.value("units_done", 0),
               st.value("leases_issued", 0), st.value("reissued_acknowledged_passes", -1));
+}
+
+// Adaptive passes open at barriers whose counts the coordinator stores before leasing them: killed
+// inside one, it resumes with the same counts, and the image is `tessera render --adaptive on`'s.
+TEST(FarmIntegration, AdaptiveJobSurvivesAKilledCoordinatorBitForBit) {
+  TESSERA_REQUIRE_FILE(cornell());
+  Farm farm;
+  ASSERT_TRUE(start_with_two_workers(farm));
+  JobSettings settings = long_job();  // passes from sample 63 adapt (at a quarter of 150 or later)
+  settings.adaptive = true;
+  uint64_t id = farm.submit(cornell(), settings);
+  ASSERT_GT(id, 0u);
+  nlohmann::json mid = farm.wait_until(id, [](const nlohmann::json& j) { return progress(j) > 0.55; });
+  ASSERT_EQ(mid.value("state", ""), "running");
+  farm.kill_server();
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  farm.start_server();
+  nlohmann::json st = farm.wait_job(id);
+  ASSERT_EQ(st.value("state", ""), "done") << st.dump(2);
+  EXPECT_EQ(st.value("samples_done", uint64_t(0)), uint64_t(120 * 96 * 150)) << "--spp is the total";
+  EXPECT_EQ(differing_pixels(farm.image(id), local_render(cornell(), settings)), 0);
+  std::printf("adaptive job: coordinator killed at %d/%d units\n", mid.value("units_done", 0),
+              mid.value("units_total", 0));
 }
 
 TEST(FarmIntegration, HigherPriorityJobOvertakesAndCancelStopsAJob) {
@@ -263,10 +285,12 @@ TEST(FarmIntegration, SubmitCommandDownloadsTheSameImage) {
   const std::string log = farm.log("submit");
   const std::string cli = std::string(TESSERA_CLI_BIN) + " ";
   std::string cmd = cli + "submit " + cornell() + " --server " + farm.url() +
-                    " --spp 37 --width 100 --height 75 --tile-size 24 --seed 11 --name from-cli -q -o " + out + " -o " +
-                    png + " > " + log + " 2>&1";
+                    " --spp 37 --width 100 --height 75 --tile-size 24 --seed 11 --adaptive on --name from-cli -q -o " +
+                    out + " -o " + png + " > " + log + " 2>&1";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
-  EXPECT_EQ(differing_pixels(read_exr(out), local_render(cornell(), small_job())), 0);
+  JobSettings adaptive = small_job();
+  adaptive.adaptive = true;
+  EXPECT_EQ(differing_pixels(read_exr(out), local_render(cornell(), adaptive)), 0);
   EXPECT_TRUE(std::filesystem::file_size(png) > 100);
 
   const std::string jobs = farm.log("jobs");
@@ -282,6 +306,11 @@ TEST(FarmIntegration, SubmitCommandDownloadsTheSameImage) {
   TempDir bad;
   std::string xml = bad.write("bad.xml", "<scene version=\"0.6.0\"><shape type=\"obj\"/></scene>");
   EXPECT_NE(std::system((cli + "submit " + xml + " --server " + farm.url() + " > " + jobs + " 2>&1").c_str()), 0);
+  // Guiding, which the farm does not do yet, is refused with the reason rather than left out.
+  EXPECT_NE(std::system((cli + "submit " + cornell() + " --guiding on --server " + farm.url() + " > " + jobs + " 2>&1").c_str()), 0);
+  std::ifstream refused(jobs);
+  const std::string why((std::istreambuf_iterator<char>(refused)), std::istreambuf_iterator<char>());
+  EXPECT_NE(why.find("path guiding"), std::string::npos) << why;
   EXPECT_EQ(farm.client().get("/api/v1/jobs").json()["jobs"].size(), 1u);
 }
 

@@ -30,11 +30,17 @@ TEST(Protocol, JobSettingsRoundTrip) {
   s.integrator = "volpath";
   s.light_selection = "power";
   s.target_error = 0.005;
+  s.adaptive = true;
   s.webhook = "https://ci.example/hooks/render?x=1";
   JobSettings back;
   std::string error;
   ASSERT_TRUE(job_settings_from_json(to_json(s), back, error)) << error;
   EXPECT_EQ(to_json(back), to_json(s));
+  EXPECT_TRUE(back.adaptive);
+  EXPECT_FALSE(back.guiding.has_value()) << "null: as the scene says";
+  s.guiding = false;
+  ASSERT_TRUE(job_settings_from_json(to_json(s), back, error)) << error;
+  EXPECT_EQ(back.guiding, std::optional<bool>(false));
 }
 
 TEST(Protocol, JobSettingsAreStrict) {
@@ -52,6 +58,8 @@ TEST(Protocol, JobSettingsAreStrict) {
   EXPECT_NE(parse_error(json{{"scene", h}, {"target_error", "low"}}).find("'target_error'"), std::string::npos);
   EXPECT_NE(parse_error(json{{"scene", h}, {"webhook", "file:///etc/passwd"}}).find("'webhook'"), std::string::npos);
   EXPECT_NE(parse_error(json{{"scene", h}, {"webhook", 7}}).find("'webhook'"), std::string::npos);
+  EXPECT_NE(parse_error(json{{"scene", h}, {"adaptive", "on"}}).find("'adaptive' must be true or false"), std::string::npos);
+  EXPECT_NE(parse_error(json{{"scene", h}, {"guiding", 1}}).find("'guiding' must be true or false"), std::string::npos);
   JobSettings s;
   std::string error;
   EXPECT_TRUE(job_settings_from_json(json{{"spp", 3}}, s, error, /*require_scene=*/false)) << error;
@@ -109,6 +117,20 @@ TEST(Protocol, LeaseRoundTripAndCacheKey) {
   EXPECT_EQ(to_json(back), to_json(l));
   json bad = to_json(l);
   bad["rect"] = {1, 2};
+  EXPECT_FALSE(lease_from_json(bad, back, error));
+  // An adaptive pass's lease: each pixel's first sample and count.
+  l.samples = PassSamples::uniform(l.rect, 7, 15);
+  l.samples.count[3] = 20;
+  error.clear();
+  ASSERT_TRUE(lease_from_json(to_json(l), back, error)) << error;
+  EXPECT_EQ(back.samples, l.samples);
+  bad = to_json(l);
+  bad["count"].erase(0);
+  error.clear();
+  EXPECT_FALSE(lease_from_json(bad, back, error));
+  EXPECT_NE(error.find("one entry per pixel"), std::string::npos) << error;
+  bad = to_json(l);
+  bad["first"][0] = 4294967290u;
   EXPECT_FALSE(lease_from_json(bad, back, error));
   // The cache key changes with anything that changes the loaded scene, not with the seed.
   JobSettings a = l.settings, b = a;

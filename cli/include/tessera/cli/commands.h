@@ -43,6 +43,8 @@ struct SubmitOptions {
   std::map<std::string, std::string> defines;
   std::string integrator, light_selection, name;
   double target_error = 0;           // stop at this estimated relMSE (spp is then the budget)
+  std::string guiding;               // "on", "off"; empty: as the scene says
+  std::string adaptive = "off";      // adaptive sampling: "on" or "off"
   std::string webhook;               // URL the coordinator POSTs the job's status to when it ends
   std::string frames;                // "A-B": one job per frame (-D frame=N); outputs carry ####
   bool wait = false, quiet = false;

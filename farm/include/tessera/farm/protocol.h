@@ -3,6 +3,7 @@
 // are errors naming the field, because a typo in a job must not silently render something else.
 #pragma once
 
+#include "tessera/render/adaptive.h"
 #include "tessera/render/film.h"
 
 #include <nlohmann/json.hpp>
@@ -30,6 +31,12 @@ struct JobSettings {
   /// > 0: stop once the estimated relMSE of the image (noise_estimate.h) is at most this, at a
   /// pass boundary; `spp` is then the budget. The image equals `tessera render` at the spp reached.
   double target_error = 0;
+  /// Adaptive sampling (render/adaptive.h): later passes spend the budget where the film's variance
+  /// is. The farm decides each such pass's counts at its barrier, from the film, as render() does.
+  bool adaptive = false;
+  /// Path guiding: empty lets the scene decide (its guided_path integrator asks for it). The farm
+  /// does not guide yet, so a job that would be guided is refused rather than rendered otherwise.
+  std::optional<bool> guiding;
   std::string webhook;          // http(s) URL POSTed the job's status when it ends; empty: none
 };
 
@@ -60,13 +67,15 @@ struct JobRequest {
 /// Range checks after the scene's defaults are known.
 [[nodiscard]] bool check_job_limits(const JobSettings& s, const JobLimits& limits, std::string& error);
 
-/// One unit of work: samples [sample_begin, sample_end) of every pixel of `rect`.
+/// One unit of work: samples [sample_begin, sample_end) of every pixel of `rect`, or in an adaptive
+/// pass the samples `samples` gives each pixel (sample_begin/end then name the pass's nominal range).
 struct Lease {
   uint64_t id = 0;
   uint64_t job_id = 0;
   uint32_t tile = 0, pass = 0;
   TileRect rect;
   uint32_t sample_begin = 0, sample_end = 0;
+  PassSamples samples;           // an adaptive pass's per-pixel samples over `rect`; else empty
   double seconds_to_expiry = 0;  // heartbeat before this
   JobSettings settings;          // the job's, with spp/width/height resolved
   std::string scene_file;        // resolved XML path inside the bundle

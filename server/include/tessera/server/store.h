@@ -106,6 +106,10 @@ class Store {
   /// Calls `fn` for every result of `job`, ordered by pass then tile (`with_data`: the bytes too;
   /// empty for a pass a checkpoint holds).
   void for_each_result(uint64_t job, const std::function<void(ResultRow&&)>& fn, bool with_data = true);
+  /// Stores an adaptive pass's per-pixel sample counts (sample_counts.h bytes); replaces a copy.
+  void save_pass_plan(uint64_t job, uint32_t pass, const std::string& data);
+  /// Calls `fn(pass, bytes)` for every stored pass plan of `job`, in pass order.
+  void for_each_pass_plan(uint64_t job, const std::function<void(uint32_t, std::string&&)>& fn);
   /// Leases issued for a pass after that pass had been acknowledged (should be 0: the measure the
   /// restart test reads).
   uint64_t reissued_after_ack(uint64_t job);
