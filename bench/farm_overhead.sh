@@ -3,8 +3,9 @@
 # 1 and 2 local workers vs `tessera render` on the same cores, the coordinator's CPU time per work
 # unit, and the bytes a unit's result takes on the wire. Checks the images are bit-identical.
 # With ADAPTIVE=on, both render with --adaptive on, and the time the coordinator spent deciding the
-# adaptive passes' counts at their barriers is printed too.
-# Usage: bench/farm_overhead.sh [BUILD_DIR] [SPP] [SIZE] [TILE] [ADAPTIVE]
+# adaptive passes' counts at their barriers is printed too. With GUIDING=on, both guide, and the
+# learned trees' bytes (as stored and sent to workers) and the time spent making them are printed.
+# Usage: bench/farm_overhead.sh [BUILD_DIR] [SPP] [SIZE] [TILE] [ADAPTIVE] [GUIDING] [SCENE]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build}
@@ -12,7 +13,8 @@ spp=${2:-256}
 size=${3:-256}
 tile=${4:-32}
 adaptive=${5:-off}
-scene=../shared/scenes/cornell-box/scene.xml
+guiding=${6:-off}
+scene=${7:-../shared/scenes/cornell-box/scene.xml}
 cores=$(nproc)
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
@@ -20,9 +22,10 @@ now() { date +%s.%N; }
 
 t0=$(now)
 "$build/cli/tessera" render "$scene" --spp "$spp" --width "$size" --height "$size" --tile-size "$tile" -q \
-    --adaptive "$adaptive" -o "$tmp/local.exr" 2> /dev/null
+    --adaptive "$adaptive" --guiding "$guiding" -o "$tmp/local.exr" 2> /dev/null
 local_s=$(echo "$(now) - $t0" | bc -l)
-printf "cornell %dx%d %d spp, %d cores, tile %d, adaptive %s\n" "$size" "$size" "$spp" "$cores" "$tile" "$adaptive"
+printf "%s %dx%d %d spp, %d cores, tile %d, adaptive %s, guiding %s\n" "$(basename "$(dirname "$scene")")" "$size" \
+    "$size" "$spp" "$cores" "$tile" "$adaptive" "$guiding"
 printf "%-28s %8.2f s\n" "tessera render ($cores threads)" "$local_s"
 
 for workers in 1 2; do
@@ -38,7 +41,7 @@ for workers in 1 2; do
   read -r u0 s0 < <(awk '{print $14, $15}' "/proc/$server/stat")
   t0=$(now)
   "$build/cli/tessera" submit "$scene" --server "$url" --spp "$spp" --width "$size" --height "$size" \
-      --tile-size "$tile" --adaptive "$adaptive" -q -o "$data/farm.exr" 2> /dev/null > /dev/null
+      --tile-size "$tile" --adaptive "$adaptive" --guiding "$guiding" -q -o "$data/farm.exr" 2> /dev/null > /dev/null
   wall=$(echo "$(now) - $t0" | bc -l)
   read -r u1 s1 < <(awk '{print $14, $15}' "/proc/$server/stat")
   status=$(curl -sf "$url/api/v1/jobs/1")
@@ -55,5 +58,13 @@ for workers in 1 2; do
   if [ -n "$planned" ]; then
     printf "%-28s %d adaptive passes planned at barriers in %.1f ms in all\n" "" "$(echo "$planned" | wc -l)" \
         "$(echo "$planned" | awk '{s += $1} END {print 1000 * s}')"
+  fi
+  guides=$(grep -o 'job.guide_stored.*' "$data/server.log" || true)
+  if [ -n "$guides" ]; then
+    field() { echo "$guides" | grep -o " $1=[0-9.e+-]*" | cut -d= -f2; }
+    printf "%-28s %d guides stored, %.2f MB in all (last %.2f MB, %.1f MB in memory); trees made at barriers in %.1f ms, encoded and written in %.1f ms in all\n" \
+        "" "$(echo "$guides" | wc -l)" "$(field bytes | awk '{s += $1} END {print s / 1e6}')" \
+        "$(field bytes | tail -1 | awk '{print $1 / 1e6}')" "$(field tree_bytes | tail -1 | awk '{print $1 / 1e6}')" \
+        "$(field barrier_seconds | awk '{s += $1} END {print 1000 * s}')" "$(field seconds | awk '{s += $1} END {print 1000 * s}')"
   fi
 done

@@ -127,8 +127,8 @@ int main_entry(int argc, char** argv) {
   sub->add_option("--target-error", submit.target_error, "Stop at this estimated relMSE (--spp is then the budget)")
       ->check(CLI::Range(0.0, 1.0));
   sub->add_option("--guiding", submit.guiding,
-                  "Path guiding, as for render; the farm does not guide yet and refuses a job that would be "
-                  "guided (default: on for a guided_path integrator, else off)")
+                  "Path guiding, as for render: the same image (default: on for a guided_path integrator, "
+                  "else off)")
       ->check(CLI::IsMember({"on", "off"}));
   sub->add_option("--adaptive", submit.adaptive, "Adaptive sampling, as for render: the same image (default off)")
       ->check(CLI::IsMember({"on", "off"}))->capture_default_str();

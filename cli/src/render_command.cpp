@@ -164,6 +164,9 @@ int run_render(const RenderOptions& options) {
                  double(c.rays()) / std::max(stats.seconds, 1e-9));
     if (c.nonfinite > 0) std::fprintf(stderr, "; %llu NaN/Inf samples dropped", (unsigned long long)c.nonfinite);
     std::fprintf(stderr, "\n");
+    if (stats.guide_leaves > 0)
+      std::fprintf(stderr, "guide: %zu spatial leaves, %.1f MB (cap %.0f MB)\n", stats.guide_leaves,
+                   double(stats.guide_bytes) / 1e6, double(settings.guiding_settings.max_bytes) / 1e6);
     if (settings.target_error > 0)
       std::fprintf(stderr, "target error %g: %s at %u spp, estimated relMSE %.4g\n", settings.target_error,
                    stats.spp_done < uint32_t(settings.spp) ? "stopped" : "not reached, budget spent", stats.spp_done,

@@ -38,6 +38,9 @@ HttpReply FarmApi::upload_scene(const std::string& bundle, double timeout) const
 HttpReply FarmApi::download_scene(const std::string& hash, double timeout) const {
   return http_.get(kApi + "/scenes/" + hash, timeout);
 }
+HttpReply FarmApi::download_guide(const std::string& hash, double timeout) const {
+  return http_.get(kApi + "/guides/" + hash, timeout);
+}
 HttpReply FarmApi::submit_job(const json& settings, const std::string& bundle, double timeout) const {
   if (bundle.empty()) return http_.post_json(kApi + "/jobs", settings, timeout);
   return http_.post_settings_and_bundle(kApi + "/jobs", settings, bundle, timeout);

@@ -1,6 +1,7 @@
 #include "tessera/farm/job_scene.h"
 
 #include "tessera/farm/bundle.h"
+#include "tessera/guiding/tree_io.h"
 #include "tessera/light/light_sampler.h"
 #include "tessera/render/renderer.h"
 #include "tessera/scene/error.h"
@@ -39,15 +40,12 @@ LoadedJobScene load_job_scene(const std::string& bundle_dir, const std::string& 
 JobPlan make_job_plan(const std::string& bundle_dir, const std::string& scene_file, const JobSettings& settings,
                       const LoadedJobScene& scene) {
   const Scene& s = *scene.loaded.scene;
-  // The farm does not guide yet: rendering such a job unguided would give another image than
-  // `tessera render` does with the same flags.
-  if (settings.guiding.value_or(s.integrator.guiding.has_value()))
-    throw SceneError(FileLoc{scene_file, 0},
-                     std::string(settings.guiding ? "the job asks for path guiding" :
-                                                    "the scene's guided_path integrator asks for path guiding") +
-                         ", which the farm does not do yet; render it with `tessera render`, or submit it with "
-                         "--guiding off");
   JobPlan plan;
+  // Guided as `tessera render` guides: as the job says, else as the scene's integrator does, on
+  // path and volpath with something to guide over.
+  if (settings.guiding.value_or(s.integrator.guiding.has_value()) && s.integrator.type != IntegratorType::Direct &&
+      !s.bounds().empty())
+    plan.guide = JobPlan::Guide{s.bounds(), s.integrator.guiding.value_or(GuidingSettings{})};
   plan.settings = settings;
   plan.settings.spp = s.sampler.sample_count;
   plan.settings.width = s.film.width;
@@ -79,17 +77,64 @@ void begin_tile_result(const Lease& lease, TileResult& out) {
   out.film.reset(lease.rect);
 }
 
-TileResult render_lease(const Scene& scene, const Lease& lease) {
+TileResult render_lease(const Scene& scene, const Lease& lease, const SpatialTree* guide) {
   TileResult result;
   begin_tile_result(lease, result);
   const auto t0 = std::chrono::steady_clock::now();
-  if (lease.samples.count.empty())
-    render_tile(scene, lease.rect, lease.sample_begin, lease.sample_end, lease.settings.seed, result.film);
-  else
-    render_tile(scene, lease.rect, lease.samples, lease.settings.seed, result.film);
+  const PassSamples samples = lease.samples.count.empty()
+                                  ? PassSamples::uniform(lease.rect, lease.sample_begin, lease.sample_end)
+                                  : lease.samples;
+  if (lease.guide) {
+    if (!guide) throw std::invalid_argument("render_lease: a guided lease without its guide");
+    // Training goes into a recorder of the guide, whose nonzero sums travel with the result.
+    std::optional<SpatialTree> recorder;
+    if (lease.guide->train) recorder = make_recorder(*guide);
+    const PathGuide path_guide{guide, recorder ? &*recorder : nullptr, lease.guide->iteration > 0, lease.guide->train};
+    render_tile(scene, lease.rect, samples, lease.settings.seed, result.film, &path_guide);
+    if (recorder) result.training = write_records(*recorder);
+  } else {
+    render_tile(scene, lease.rect, samples, lease.settings.seed, result.film);
+  }
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return result;
 }
+
+namespace {
+
+using nlohmann::json;
+
+json guide_json(const JobPlan::Guide& g) {
+  const GuidingSettings& s = g.settings;
+  return {{"bounds", {g.bounds.lo.x, g.bounds.lo.y, g.bounds.lo.z, g.bounds.hi.x, g.bounds.hi.y, g.bounds.hi.z}},
+          {"spatial_threshold", s.spatial_threshold},
+          {"directional_threshold", s.directional_threshold},
+          {"max_bytes", s.max_bytes},
+          {"bsdf_fraction", s.bsdf_fraction},
+          {"learn_bsdf_fraction", s.learn_bsdf_fraction},
+          {"min_bsdf_fraction", s.min_bsdf_fraction},
+          {"keep_energy", s.keep_energy},
+          {"discard_training", s.discard_training}};
+}
+
+JobPlan::Guide guide_from_json(const json& j) {
+  JobPlan::Guide g;
+  const auto b = j.at("bounds").get<std::vector<float>>();
+  if (b.size() != 6) throw std::invalid_argument("guide bounds");
+  g.bounds.lo = Vec3(b[0], b[1], b[2]);
+  g.bounds.hi = Vec3(b[3], b[4], b[5]);
+  GuidingSettings& s = g.settings;
+  s.spatial_threshold = j.at("spatial_threshold").get<double>();
+  s.directional_threshold = j.at("directional_threshold").get<double>();
+  s.max_bytes = j.at("max_bytes").get<size_t>();
+  s.bsdf_fraction = j.at("bsdf_fraction").get<float>();
+  s.learn_bsdf_fraction = j.at("learn_bsdf_fraction").get<bool>();
+  s.min_bsdf_fraction = j.at("min_bsdf_fraction").get<float>();
+  s.keep_energy = j.at("keep_energy").get<bool>();
+  s.discard_training = j.at("discard_training").get<bool>();
+  return g;
+}
+
+}  // namespace
 
 nlohmann::json to_json(const JobPlan& p) {
   return {{"settings", to_json(p.settings)},
@@ -100,7 +145,8 @@ nlohmann::json to_json(const JobPlan& p) {
           {"full_height", p.full_height},
           {"ldr", p.ldr},
           {"gamma", p.gamma},
-          {"exposure", p.exposure}};
+          {"exposure", p.exposure},
+          {"guide", p.guide ? guide_json(*p.guide) : json(nullptr)}};
 }
 
 bool job_plan_from_json(const nlohmann::json& j, JobPlan& out, std::string& error) {
@@ -116,6 +162,8 @@ bool job_plan_from_json(const nlohmann::json& j, JobPlan& out, std::string& erro
     out.ldr = j.at("ldr").get<bool>();
     out.gamma = j.at("gamma").get<float>();
     out.exposure = j.at("exposure").get<float>();
+    out.guide.reset();
+    if (j.contains("guide") && !j["guide"].is_null()) out.guide = guide_from_json(j["guide"]);
     return true;
   } catch (const std::exception& e) {
     error = std::string("job plan: ") + e.what();

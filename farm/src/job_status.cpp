@@ -43,6 +43,8 @@ json to_json(const JobStatus& s) {
             {"target_error", s.target_error},
             {"spp_done", s.spp_done},
             {"stopped_at_target", s.stopped_at_target}};
+  j["guide"] = s.guide ? json{{"iterations", s.guide->iterations}, {"leaves", s.guide->leaves}, {"bytes", s.guide->bytes}}
+                       : json(nullptr);
   // (Left out rather than null when the lease log could not be read, as before.)
   if (s.leases_issued) j["leases_issued"] = *s.leases_issued;
   if (s.reissued_acknowledged_passes) j["reissued_acknowledged_passes"] = *s.reissued_acknowledged_passes;

@@ -252,6 +252,7 @@ json lease_own_json(const Lease& l) {
     j["first"] = l.samples.first;
     j["count"] = l.samples.count;
   }
+  if (l.guide) j["guide"] = {{"hash", l.guide->hash}, {"iteration", l.guide->iteration}, {"train", l.guide->train}};
   return j;
 }
 
@@ -305,6 +306,8 @@ bool lease_from_json(const json& j, Lease& out, std::string& error) {
   f.get("first", out.samples.first);
   f.get("count", out.samples.count);
   f.get("seconds_to_expiry", out.seconds_to_expiry);
+  json guide;
+  f.get("guide", guide);
   f.get("settings", settings, true);
   f.get("scene_file", out.scene_file, true);
   f.get_list("files", out.files);
@@ -321,6 +324,21 @@ bool lease_from_json(const json& j, Lease& out, std::string& error) {
   }
   out.samples.rect = out.rect;
   if (!lease_samples_valid(out, error)) return false;
+  out.guide.reset();
+  if (!guide.is_null()) {
+    Lease::Guide g;
+    Fields h(guide, error, "lease guide");
+    h.get("hash", g.hash, true);
+    h.get("iteration", g.iteration, true);
+    h.get("train", g.train, true);
+    h.finish();
+    if (!h.ok()) return false;
+    if (!is_sha256_hex(g.hash)) {
+      error = "lease guide: 'hash' must be a SHA-256 (64 lowercase hex digits)";
+      return false;
+    }
+    out.guide = g;
+  }
   return job_settings_from_json(settings, out.settings, error);
 }
 

@@ -15,10 +15,12 @@ namespace {
 
 static_assert(std::endian::native == std::endian::little, "the tile format is little-endian");
 constexpr char kMagic[4] = {'T', 'S', 'T', 'R'};
-// Version 2 ends in an XXH3-128 checksum; version 1 (results and checkpoints stored by earlier
-// versions) in a SHA-256. The checksum guards against corruption in transit and on disk, not against
-// an adversary (tokens do that), and SHA-256 was a tenth of the coordinator's time per unit.
-constexpr uint32_t kVersion = 2;
+// Version 3 adds training records; version 2 ends in an XXH3-128 checksum; version 1 (results and
+// checkpoints stored by earlier versions) in a SHA-256. The checksum guards against corruption in
+// transit and on disk, not against an adversary (tokens do that), and SHA-256 was a tenth of the
+// coordinator's time per unit.
+constexpr uint32_t kVersion = 3;
+constexpr uint32_t kVersionNoTraining = 2;
 constexpr uint32_t kVersionSha256 = 1;
 constexpr size_t kHeaderBytes = 4 + 4 + 8 + 4 + 4 + 16 + 8 + 5 * 8 + 8;
 constexpr size_t kPixelBytes = 7 * 8;
@@ -72,6 +74,8 @@ std::string encode_tile_result(const TileResult& r, int level) {
   for (uint64_t v : {c.samples, c.camera_rays, c.bounce_rays, c.shadow_rays, c.nonfinite}) put(raw, v);
   put(raw, r.seconds);
   raw.append(reinterpret_cast<const char*>(r.film.pixels().data()), r.film.pixels().size() * kPixelBytes);
+  put(raw, uint64_t(r.training.size()));
+  raw.append(r.training);
   const auto digest = checksum(raw);
   raw.append(digest.data(), digest.size());
   if (level == kUncompressed) return raw;
@@ -88,7 +92,8 @@ namespace {
 // the parts separately), or an error if a frame is malformed, does not state its size, or the total
 // exceeds what `max_pixels` allows.
 bool decompressed_size(std::string_view bytes, unsigned long long& size, std::string& error, int64_t max_pixels) {
-  const unsigned long long max_size = kHeaderBytes + kMaxDigestBytes + (unsigned long long)max_pixels * kPixelBytes;
+  const unsigned long long max_size =
+      kHeaderBytes + kMaxDigestBytes + (unsigned long long)max_pixels * kPixelBytes + 8 + kMaxTrainingBytes;
   size = 0;
   for (size_t pos = 0; pos < bytes.size();) {
     const unsigned long long n = ZSTD_getFrameContentSize(bytes.data() + pos, bytes.size() - pos);
@@ -156,7 +161,7 @@ bool decode_tile_result(std::string_view bytes, TileResult& out, std::string& er
   }
   rd.pos = 4;
   const uint32_t version = rd.get<uint32_t>();
-  if (version != kVersion && version != kVersionSha256) {
+  if (version != kVersion && version != kVersionNoTraining && version != kVersionSha256) {
     error = "tile result: format version " + std::to_string(version) + ", expected " + std::to_string(kVersion);
     return false;
   }
@@ -172,8 +177,16 @@ bool decode_tile_result(std::string_view bytes, TileResult& out, std::string& er
   rect.y0 = rd.get<int32_t>();
   rect.x1 = rd.get<int32_t>();
   rect.y1 = rd.get<int32_t>();
-  if (rect.empty() || rect.x0 < 0 || rect.y0 < 0 || rect.area() > max_pixels ||
-      raw.size() != kHeaderBytes + digest_bytes(version) + size_t(rect.area()) * kPixelBytes) {
+  const size_t pixel_end = kHeaderBytes + size_t(rect.area()) * kPixelBytes;
+  const size_t body = raw.size() - digest_bytes(version);
+  uint64_t training = 0;
+  if (version == kVersion && body >= pixel_end + 8) std::memcpy(&training, raw.data() + pixel_end, 8);
+  const size_t extra = version == kVersion ? 8 + size_t(std::min<uint64_t>(training, kMaxTrainingBytes + 1)) : 0;
+  if (rect.area() > max_pixels) {
+    error = "tile result: " + std::to_string(rect.area()) + " pixels, over the limit of " + std::to_string(max_pixels);
+    return false;
+  }
+  if (rect.empty() || rect.x0 < 0 || rect.y0 < 0 || training > kMaxTrainingBytes || body != pixel_end + extra) {
     error = "tile result: pixel data does not match the tile's rectangle";
     return false;
   }
@@ -184,6 +197,7 @@ bool decode_tile_result(std::string_view bytes, TileResult& out, std::string& er
   for (uint64_t* v : {&c.samples, &c.camera_rays, &c.bounce_rays, &c.shadow_rays, &c.nonfinite}) *v = rd.get<uint64_t>();
   out.seconds = rd.get<double>();
   std::memcpy(out.film.mutable_pixels().data(), raw.data() + rd.pos, out.film.pixels().size() * kPixelBytes);
+  out.training.assign(raw.data() + pixel_end + (extra ? 8 : 0), size_t(training));
   return true;
 }
 

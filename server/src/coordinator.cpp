@@ -3,13 +3,16 @@
 #include "disk_full.h"
 #include "event_log.h"
 
+#include "tessera/farm/guide_artifact.h"
 #include "tessera/farm/sample_counts.h"
+#include "tessera/farm/sha256.h"
 #include "tessera/farm/tile_result.h"
 #include "tessera/image/image.h"
 
 #include <spdlog/spdlog.h>
 
 #include <filesystem>
+#include <fstream>
 
 namespace tessera::server {
 
@@ -47,6 +50,7 @@ std::string prepare_data_dir(const std::string& dir) {
   fs::create_directories(fs::path(dir) / "scenes");
   fs::create_directories(fs::path(dir) / "tmp");
   fs::create_directories(fs::path(dir) / "images");
+  fs::create_directories(fs::path(dir) / "guides");
   return (fs::path(dir) / "state.sqlite").string();
 }
 }  // namespace
@@ -56,6 +60,9 @@ Coordinator::Impl::Impl(CoordinatorOptions o)
 
 std::string Coordinator::Impl::bundle_path(const std::string& hash) const {
   return (fs::path(opt.data_dir) / "bundles" / (hash + ".bundle")).string();
+}
+std::string Coordinator::Impl::guide_path(const std::string& hash) const {
+  return (fs::path(opt.data_dir) / "guides" / (hash + ".guide")).string();
 }
 std::string Coordinator::Impl::scene_dir(const std::string& hash) const {
   return (fs::path(opt.data_dir) / "scenes" / hash).string();
@@ -86,6 +93,7 @@ Coordinator::Coordinator(CoordinatorOptions options) : impl_(std::make_unique<Im
     }
     JobState& job = *s.jobs.emplace(row.id, s.rebuild_job(row)).first->second;
     s.save_pass_plans(job);
+    s.save_guides(job);
     passes += job.done_units();
     if (!is_terminal(job.phase) && job.complete()) {  // its last result landed before a crash
       (void)s.change_phase(job, JobPhase::Done);
@@ -170,6 +178,7 @@ std::unique_ptr<JobState> Coordinator::Impl::rebuild_job(const JobRow& row) {
   auto job = job_from_row(row);
   const std::string where = "job " + std::to_string(row.id) + ": ";
   job->begin_rebuild();
+  if (job->guide()) restore_guide(*job);
   // An adaptive job's decided passes first: its results are checked against them.
   store.for_each_pass_plan(row.id, [&](uint32_t pass, std::string&& data) {
     std::vector<uint32_t> counts;
@@ -227,6 +236,56 @@ void Coordinator::Impl::save_pass_plans(JobState& job) {
     (void)commits.append([id = job.id(), pass = d.pass, counts](Store& st) {
       st.save_pass_plan(id, pass, encode_sample_counts(*counts));
     }, GroupCommit::Retry::UntilDurable);
+  }
+}
+
+void Coordinator::Impl::restore_guide(JobState& job) {
+  std::vector<std::string> hashes = store.guides(job.id());
+  if (hashes.empty()) return;  // (not even its first tree was stored: it is made again)
+  std::ifstream in(guide_path(hashes.back()), std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto tree = std::make_shared<SpatialTree>();
+  std::string error;
+  if (sha256_hex(bytes) != hashes.back() || !decode_guide(bytes, *tree, error))
+    throw std::runtime_error("job " + std::to_string(job.id()) + ": its stored guide " + hashes.back() +
+                             " is missing or corrupt " + error);
+  const uint32_t next = uint32_t(hashes.size() - 1);  // the pass it trains (if it trains one)
+  job.restore_guide(std::move(hashes), std::move(tree));
+  if (job.guide()->trains(next))
+    store.for_each_training(job.id(), next, [&](std::string&& records) { job.restore_training(records); });
+}
+
+void Coordinator::Impl::save_guides(JobState& job) {
+  while (auto made = job.take_tree_to_store()) {
+    background.push([this, id = job.id(), iteration = made->first, tree = made->second,
+                     barrier = job.guide()->end_seconds()] {
+      const auto t0 = std::chrono::steady_clock::now();
+      const std::string bytes = encode_guide(*tree), hash = sha256_hex(bytes);
+      std::string error;
+      try {
+        write_file_durably(guide_path(hash), bytes);
+      } catch (const std::exception& e) {
+        error = e.what();
+      }
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      std::lock_guard<std::mutex> lock(mu);
+      auto it = jobs.find(id);
+      if (it == jobs.end() || is_terminal(it->second->phase)) return;
+      JobState& job = *it->second;
+      if (!error.empty()) {
+        (void)change_phase(job, JobPhase::Failed, "cannot store the job's guide: " + error);
+        return;
+      }
+      // Retried until stored, ahead of the leases appended after it: a lease that renders with
+      // the tree is handed out only once its row is durable.
+      (void)commits.append([id, iteration, hash](Store& st) { st.save_guide(id, iteration, hash); },
+                           GroupCommit::Retry::UntilDurable);
+      log_event(spdlog::level::info, "job.guide_stored",
+                {{"job", id}, {"iteration", iteration}, {"leaves", tree->leaf_count()}, {"tree_bytes", tree->bytes()},
+                 {"bytes", bytes.size()}, {"barrier_seconds", barrier}, {"seconds", seconds}});
+      job.guide_stored(iteration, hash);
+      work_cv.notify_all();
+    });
   }
 }
 

@@ -127,6 +127,14 @@ struct Coordinator::Impl {
   void checkpoint_tile(JobState& job, uint32_t tile, uint32_t min_new);
   /// Under `mu`: appends the adaptive passes the job decided since the last call to the store.
   void save_pass_plans(JobState& job);
+  /// Under `mu`: a guided job's new tree is encoded and written off the lock (background), then
+  /// its row appended and the passes that render with it opened.
+  void save_guides(JobState& job);
+  /// Rebuilding: the job's stored trees and the training records of the pass it trains next.
+  void restore_guide(JobState& job);
+  std::string guide_path(const std::string& hash) const;
+  /// Retention: the guide files no job names any more (and not just written), into `trash`.
+  void collect_unused_guides(std::vector<std::filesystem::path>& trash);
   /// Not under `mu`: waits for a group-commit ticket; the error (500/507) if its batch failed.
   Status durable(uint64_t ticket);
   /// Under `mu`: a second result for a done unit is dropped, and compared with the first when its
@@ -221,6 +229,10 @@ struct Coordinator::Impl {
 };
 
 double wall_seconds();
+/// Writes `bytes` to a temporary name, fsyncs, renames to `path` and fsyncs its directory: after a
+/// crash the file is either complete or absent. Throws (DiskFullError on a full disk).
+void write_file_durably(const std::string& path, const std::string& bytes);
+
 /// A tile's checkpoint as stored: tile_result.h bytes (pass: its last pass; samples 0..sample_end).
 std::string encode_checkpoint(uint64_t job, const JobState::Checkpoint& cp);
 Status internal_error(const std::exception& e);

@@ -26,8 +26,6 @@ namespace tessera::server {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-namespace {
-
 // Written to a temporary name, fsync'd, renamed, directory fsync'd: after a crash the file is
 // either complete or absent.
 void write_file_durably(const std::string& path, const std::string& bytes) {
@@ -57,6 +55,9 @@ void write_file_durably(const std::string& path, const std::string& bytes) {
     ::close(dir);
   }
 }
+
+namespace {
+
 
 std::string read_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -116,6 +117,20 @@ Result<std::string> Coordinator::scene_bundle(const std::string& hash) {
   if (!path.ok()) return path.status;
   try {
     std::string bytes = read_file(path.value);
+    std::lock_guard<std::mutex> lock(impl_->mu);
+    impl_->counters.bytes_out += bytes.size();
+    return bytes;
+  } catch (const std::exception& e) {
+    return internal_error(e);
+  }
+}
+
+Result<std::string> Coordinator::guide(const std::string& hash) {
+  if (!is_sha256_hex(hash)) return make_error(Code::BadRequest, "bad_hash", "'" + hash + "' is not a SHA-256 hash");
+  const std::string path = impl_->guide_path(hash);
+  if (!fs::exists(path)) return make_error(Code::NotFound, "unknown_guide", "no guide " + hash);
+  try {
+    std::string bytes = read_file(path);  // (immutable once written: no lock)
     std::lock_guard<std::mutex> lock(impl_->mu);
     impl_->counters.bytes_out += bytes.size();
     return bytes;
@@ -256,6 +271,7 @@ Result<JobStatus> Coordinator::Impl::add_job(const std::string& name, JobPlan pl
     std::lock_guard<std::mutex> lock(mu);
     --submissions_in_flight;
     status = status_of(*job);
+    save_guides(*job);
     jobs.emplace(id, std::move(job));
     work_cv.notify_all();
   }
@@ -304,6 +320,7 @@ JobStatus Coordinator::Impl::status_of(const JobState& job) const {
   s.target_error = p.settings.target_error;
   s.spp_done = job.spp_complete();
   s.stopped_at_target = job.converged();
+  if (const JobGuide* g = job.guide()) s.guide = JobStatus::Guide{job.guide_iterations(), g->tree_leaves(), g->tree_bytes()};
   return s;
 }
 
@@ -457,6 +474,7 @@ Status Coordinator::retry_job(uint64_t id) {
   if (it->second->phase != JobPhase::Failed && it->second->phase != JobPhase::Cancelled)
     return not_ended(it->second->phase);  // (retried by another request meanwhile)
   s.save_pass_plans(*job);
+  s.save_guides(*job);
   const uint64_t ticket = s.change_phase(*job, JobPhase::Queued);
   it->second = std::move(job);
   lock.unlock();

@@ -129,6 +129,7 @@ Coordinator::Impl::IssuedLease Coordinator::Impl::issue_lease(uint64_t worker, W
   l.sample_begin = job.sample_begin(unit);
   l.sample_end = job.sample_end(unit);
   if (std::optional<PassSamples> samples = job.lease_samples(unit)) l.samples = std::move(*samples);
+  l.guide = job.lease_guide(unit);
   l.seconds_to_expiry = opt.heartbeat_interval * kMissedHeartbeats;
   l.settings = job.plan().settings;
   l.scene_file = job.plan().scene_file;
@@ -254,6 +255,9 @@ Result<size_t> Coordinator::Impl::check_result(uint64_t worker, const TileResult
   if (!job.is_done(unit) && !job.result_fits(unit, result.film))
     return make_error(Code::BadRequest, "bad_result",
                       "the result's per-pixel sample counts are not those its adaptive pass gives the tile");
+  std::string error;
+  if (!job.is_done(unit) && !job.check_training(unit, result.training, error))
+    return make_error(Code::BadRequest, "bad_result", error);
   return unit;
 }
 
@@ -268,8 +272,9 @@ void Coordinator::Impl::result_committed(bool durable, uint64_t job_id, size_t u
     return;
   }
   const uint64_t samples = job.unit_samples(unit);
-  if (!job.add_result(unit, std::move(result.film), worker)) return;  // (a retry rebuilt it meanwhile)
+  if (!job.add_result(unit, std::move(result.film), worker, result.training)) return;  // (a retry rebuilt it meanwhile)
   save_pass_plans(job);
+  save_guides(job);
   checkpoint_tile(job, job.tile_of(unit), 1);
   job.result_bytes += bytes;
   ++counters.done;
@@ -296,9 +301,10 @@ uint64_t Coordinator::Impl::commit_result(JobState& job, size_t unit, uint64_t w
   // its result will be checked against this one.
   if (job.active_leases(unit) > 0) job.remember_digest(unit, tile_digest(result->film));
   return commits.append(
-      [id = job.id(), tile = result->tile, pass = result->pass, worker, cp, data = cp ? "" : std::string(bytes),
+      [id = job.id(), tile = result->tile, pass = result->pass, worker, cp, result, data = cp ? "" : std::string(bytes),
        now = wall_seconds()](Store& st) {
         (void)st.add_result(id, tile, pass, worker, data, now);
+        if (!result->training.empty()) st.save_training(id, tile, pass, result->training);
         // (This pass's row is stored without its bytes and the earlier ones' were dropped: nothing
         // for the checkpoint to drop, hence `from` = `passes`.)
         if (cp) st.save_checkpoint(id, tile, cp->passes, cp->passes, encode_checkpoint(id, *cp));

@@ -201,6 +201,12 @@ void install_routes(httplib::Server& http, Coordinator& c, uint64_t max_upload_b
     res.set_content(bundle.value, "application/octet-stream");
   });
 
+  http.Get(R"(/api/v1/guides/([0-9a-f]{64}))", [&c](const httplib::Request& req, httplib::Response& res) {
+    Result<std::string> guide = c.guide(req.matches[1].str());
+    if (!guide.ok()) return send_error(res, guide.status);
+    res.set_content(guide.value, "application/octet-stream");
+  });
+
   http.Post("/api/v1/jobs", [&c](const httplib::Request& req, httplib::Response& res) {
     json settings;
     std::string bundle;

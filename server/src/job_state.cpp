@@ -48,9 +48,34 @@ JobState::JobState(uint64_t id, JobPlan plan, std::string name, int priority, do
   pass_done_.assign(passes_.size(), 0);
   if (plan_.settings.adaptive)
     plans_.emplace(plan_.window, tiles_, passes_, pass_begin_, uint32_t(plan_.settings.spp));
-  open_passes_ = plan_.settings.target_error > 0 ? std::min<size_t>(1, passes_.size())
-                 : plans_                        ? plans_->first_barrier()
-                                                 : passes_.size();
+  if (plan_.guide) guide_.emplace(*plan_.guide, passes_, uint32_t(plan_.settings.spp));
+  advance_passes();
+}
+
+std::optional<Lease::Guide> JobState::lease_guide(size_t unit) const {
+  const uint32_t pass = pass_of(unit);
+  if (!guide_ || !guide_->guides(pass)) return std::nullopt;
+  return Lease::Guide{guide_->hash(guide_->iteration_of(pass)), guide_->iteration_of(pass), guide_->trains(pass)};
+}
+
+bool JobState::check_training(size_t unit, std::string_view records, std::string& error) const {
+  if (!guide_) {
+    if (records.empty()) return true;
+    error = "training records for a job that is not guided";
+    return false;
+  }
+  return guide_->check_records(pass_of(unit), records, error);
+}
+
+void JobState::guide_stored(uint32_t i, std::string hash) {
+  guide_->stored_as(i, std::move(hash));
+  advance_passes();
+}
+
+uint32_t JobState::guide_iterations() const {
+  uint32_t n = 0;
+  while (guide_ && guide_->stored(n)) ++n;
+  return n;
 }
 
 uint64_t JobState::unit_samples(size_t unit) const {
@@ -104,24 +129,35 @@ bool JobState::pass_decided_before(uint32_t pass) const {
   return false;
 }
 
-// The one place passes open. A barrier (target error, or an adaptive pass) is passed only once
-// every tile has every pass before it, when the film holds exactly those passes.
+bool JobState::at_barrier(uint32_t pass) const {
+  return (plan_.settings.target_error > 0 && pass >= 1) || (plans_ && plans_->at_barrier(pass)) ||
+         (guide_ && guide_->at_barrier(pass));
+}
+
+// The one place passes open. A barrier (target error, an adaptive pass, a guide made from the
+// pass before) is passed only once every tile has every pass before it, when the film holds
+// exactly those passes; a guided pass opens once the tree it renders with is stored.
 void JobState::advance_passes() {
   while (complete_passes_ < passes_.size() && pass_done_[complete_passes_] == tiles_.size()) ++complete_passes_;
-  while (!rebuilding_ && !converged_ && open_passes_ < passes_.size() && complete_passes_ >= open_passes_) {
+  while (!rebuilding_ && !converged_ && open_passes_ < passes_.size()) {
     const uint32_t p = uint32_t(open_passes_);
-    const bool decided = pass_decided_before(p);
-    if (!decided && film_ && plan_.settings.target_error > 0 && noise().rel_mse <= plan_.settings.target_error) {
-      converged_ = true;
-      break;
+    if (at_barrier(p)) {
+      if (complete_passes_ < p) break;
+      if (plan_.settings.target_error > 0 && !pass_decided_before(p) && film_ &&
+          noise().rel_mse <= plan_.settings.target_error) {
+        converged_ = true;
+        break;
+      }
+      if (plans_ && plans_->at_barrier(p) && !plans_->decided(p)) {
+        if (!film_) break;  // (released: the job has ended)
+        const auto t0 = std::chrono::steady_clock::now();
+        plans_->decide(p, *film_);
+        new_plans_.push_back({p, plans_->latest_counts(),
+                              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()});
+      }
+      if (guide_ && guide_->at_barrier(p) && !guide_->made(p)) guide_->end_iteration();
     }
-    if (plans_ && plans_->at_barrier(p) && !plans_->decided(p)) {
-      if (!film_) break;  // (released: the job has ended)
-      const auto t0 = std::chrono::steady_clock::now();
-      plans_->decide(p, *film_);
-      new_plans_.push_back({p, plans_->latest_counts(),
-                            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()});
-    }
+    if (guide_ && guide_->guides(p) && !guide_->stored(guide_->iteration_of(p))) break;
     ++open_passes_;
   }
 }
@@ -150,7 +186,7 @@ void JobState::mark_done(size_t unit, uint64_t worker) {
   while (complete_passes_ < passes_.size() && pass_done_[complete_passes_] == tiles_.size()) ++complete_passes_;
 }
 
-bool JobState::add_result(size_t unit, FilmTile&& tile, uint64_t worker) {
+bool JobState::add_result(size_t unit, FilmTile&& tile, uint64_t worker, std::string_view training) {
   if (done_[unit] == kDone) {
     ++duplicates;
     return false;
@@ -158,6 +194,7 @@ bool JobState::add_result(size_t unit, FilmTile&& tile, uint64_t worker) {
   if (done_[unit] == kCommitting) --tile_committing_[tile_of(unit)];
   mark_done(unit, worker);
   counters_ += tile.counters;
+  if (!training.empty()) guide_->add_records(training);  // (before a barrier may end the iteration)
 
   // Passes of a tile enter the film in pass order; a later pass waits for the earlier ones.
   const uint32_t t = tile_of(unit);
@@ -165,7 +202,7 @@ bool JobState::add_result(size_t unit, FilmTile&& tile, uint64_t worker) {
   waiting_.emplace(unit, std::move(tile));
   for (auto it = waiting_.find(this->unit(t, next_pass_[t])); it != waiting_.end();
        it = waiting_.find(this->unit(t, next_pass_[t]))) {
-    if (film_) film_->add_tile(it->second);
+    if (film_ && in_film(pass_of(it->first))) film_->add_tile(it->second);
     ++film_changes_;
     tile_counters_[t] += it->second.counters;
     waiting_.erase(it);
@@ -211,7 +248,7 @@ std::optional<JobState::Checkpoint> JobState::checkpoint_with(size_t u, const Fi
   // The same additions add_tile makes, in the same order: the film's region once it is in.
   std::vector<PixelSums>& out = cp.sums.mutable_pixels();
   const std::vector<PixelSums>& in = result.pixels();
-  for (size_t i = 0; i < out.size(); ++i) {
+  for (size_t i = 0; i < out.size() && in_film(pass_of(u)); ++i) {
     for (int c = 0; c < 3; ++c) {
       out[i].sum[c] += in[i].sum[c];
       out[i].sum_sq[c] += in[i].sum_sq[c];

@@ -4,6 +4,7 @@
 
 #include "tessera/farm/job_scene.h"
 #include "tessera/farm/sha256.h"
+#include "job_guide.h"
 #include "pass_plans.h"
 #include "tessera/image/image.h"
 #include "tessera/render/film.h"
@@ -87,6 +88,28 @@ class JobState {
   };
   /// Adaptive passes decided since the last call: stored before any of their units is leased.
   std::vector<DecidedPass> take_new_plans() { return std::move(new_plans_); }
+  // Path guiding (plan().guide): see job_guide.h. A lease of a pass that samples or trains names
+  // the guide it renders with; a training result carries records that go into the next tree.
+  /// The guide the unit renders with (when its pass samples or trains).
+  std::optional<Lease::Guide> lease_guide(size_t unit) const;
+  /// Whether a result's training records are what its unit should carry (checked, not added).
+  [[nodiscard]] bool check_training(size_t unit, std::string_view records, std::string& error) const;
+  /// The guided job's tree made at a barrier and not yet stored, once (job_guide.h).
+  std::optional<std::pair<uint32_t, std::shared_ptr<const SpatialTree>>> take_tree_to_store() {
+    return guide_ ? guide_->take_tree_to_store() : std::nullopt;
+  }
+  /// Iteration `i`'s tree is stored under `hash`: passes that render with it may open.
+  void guide_stored(uint32_t i, std::string hash);
+  /// The guided job's trees so far, and its latest tree's size (0 without guiding).
+  uint32_t guide_iterations() const;
+  const JobGuide* guide() const { return guide_ ? &*guide_ : nullptr; }
+  /// Rebuilding: the stored trees' hashes in order and the latest tree, then the training
+  /// records stored for the pass it trains next (before end_rebuild).
+  void restore_guide(std::vector<std::string> hashes, std::shared_ptr<const SpatialTree> latest) {
+    guide_->restore(std::move(hashes), std::move(latest));
+  }
+  void restore_training(std::string_view records) { guide_->add_records(records); }
+
   /// Rebuilding: an adaptive pass's stored counts, in pass order, before any result.
   [[nodiscard]] bool restore_pass_plan(uint32_t pass, std::vector<uint32_t> counts, std::string& error);
   /// While rebuilding from the store, no pass opens: once every stored result is in (end_rebuild),
@@ -128,8 +151,9 @@ class JobState {
     auto it = digests_.find(unit);
     return it == digests_.end() ? nullptr : &it->second;
   }
-  /// Adds a verified result; false when the unit was already done (a duplicate).
-  bool add_result(size_t unit, FilmTile&& tile, uint64_t worker);
+  /// Adds a verified result (with a training unit's records, checked); false when the unit was
+  /// already done (a duplicate).
+  bool add_result(size_t unit, FilmTile&& tile, uint64_t worker, std::string_view training = {});
   /// Marks a unit done without its sums (a finished job resumed from its stored image, or a pass a
   /// tile's checkpoint holds).
   void mark_done(size_t unit, uint64_t worker);
@@ -179,6 +203,7 @@ class JobState {
     film_.reset();
     film_released_ = true;
     if (plans_) plans_->release_pixels();
+    if (guide_) guide_->release_trees();
     waiting_.clear();
   }
   const RenderCounters& counters() const { return counters_; }
@@ -227,6 +252,9 @@ class JobState {
   size_t complete_passes_ = 0;       // passes every tile has
   bool converged_ = false;
   std::optional<PassPlans> plans_;  // adaptive jobs
+  std::optional<JobGuide> guide_;   // guided jobs
+  bool at_barrier(uint32_t pass) const;
+  bool in_film(uint32_t pass) const { return !guide_ || !guide_->discards(pass); }
   std::vector<DecidedPass> new_plans_;
   bool rebuilding_ = false;
   mutable std::optional<NoiseEstimate> noise_;  // for done_units_ == noise_units_

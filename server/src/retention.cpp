@@ -147,6 +147,7 @@ RetentionReport Coordinator::Impl::carry_out_retention(const RetentionPlan& plan
   for (const std::string& hash : moved) report.freed_bytes += bundles.at(hash).bytes;
   report.deleted_bundles = moved.size();
   report.data_bytes = plan.total >= report.freed_bytes ? plan.total - report.freed_bytes : 0;
+  if (report.deleted_jobs > 0) collect_unused_guides(trash);
   std::error_code ec;
   for (const fs::path& p : trash) fs::remove_all(p, ec);
   std::lock_guard<std::mutex> lock(mu);
@@ -156,6 +157,19 @@ RetentionReport Coordinator::Impl::carry_out_retention(const RetentionPlan& plan
   retention.data_bytes = report.data_bytes;
   ++retention.passes;
   return report;
+}
+
+// Guide files are shared by hash (the first tree of one scene is the same for every job of it), so
+// a deleted job's are removed once no job names them. A file younger than an hour may belong to a
+// guide whose row is still being committed.
+void Coordinator::Impl::collect_unused_guides(std::vector<fs::path>& trash) {
+  const std::set<std::string> used = store.guide_hashes();
+  std::error_code ec;
+  const auto hour_ago = fs::file_time_type::clock::now() - std::chrono::hours(1);
+  for (const auto& entry : fs::directory_iterator(fs::path(opt.data_dir) / "guides", ec))
+    if (entry.path().extension() == ".guide" && !used.count(entry.path().stem().string()) &&
+        entry.last_write_time(ec) < hour_ago)
+      trash.push_back(entry.path());
 }
 
 bool Coordinator::Impl::forget_expired_job(const RetentionJob& j) {

@@ -28,6 +28,10 @@ CREATE TABLE IF NOT EXISTS checkpoints(job INTEGER NOT NULL, tile INTEGER NOT NU
   data BLOB NOT NULL, PRIMARY KEY(job, tile));
 CREATE TABLE IF NOT EXISTS pass_plans(job INTEGER NOT NULL, pass INTEGER NOT NULL, data BLOB NOT NULL,
   PRIMARY KEY(job, pass));
+CREATE TABLE IF NOT EXISTS guides(job INTEGER NOT NULL, iteration INTEGER NOT NULL, hash TEXT NOT NULL,
+  PRIMARY KEY(job, iteration));
+CREATE TABLE IF NOT EXISTS training(job INTEGER NOT NULL, pass INTEGER NOT NULL, tile INTEGER NOT NULL,
+  data BLOB NOT NULL, PRIMARY KEY(job, pass, tile));
 CREATE TABLE IF NOT EXISTS expired_jobs(id INTEGER PRIMARY KEY, name TEXT NOT NULL, expired REAL NOT NULL);
 )";
 
@@ -301,6 +305,40 @@ void Store::for_each_pass_plan(uint64_t job, const std::function<void(uint32_t, 
   while (st.step()) fn(uint32_t(st.i(0)), st.s(1));
 }
 
+void Store::save_guide(uint64_t job, uint32_t iteration, const std::string& hash) {
+  WriteLock lock(write_mu_);
+  Stmt(db_, prepared("INSERT OR REPLACE INTO guides(job, iteration, hash) VALUES(?, ?, ?)"))
+      .bind(int64_t(job)).bind(int64_t(iteration)).bind(hash).step();
+  Stmt(db_, prepared("DELETE FROM training WHERE job = ? AND pass < ?")).bind(int64_t(job)).bind(int64_t(iteration)).step();
+}
+
+std::vector<std::string> Store::guides(uint64_t job) {
+  Stmt st(rd_, "SELECT iteration, hash FROM guides WHERE job = ? ORDER BY iteration");
+  st.bind(int64_t(job));
+  std::vector<std::string> out;
+  while (st.step() && uint64_t(st.i(0)) == out.size()) out.push_back(st.s(1));
+  return out;
+}
+
+std::set<std::string> Store::guide_hashes() {
+  Stmt st(rd_, "SELECT DISTINCT hash FROM guides");
+  std::set<std::string> out;
+  while (st.step()) out.insert(st.s(0));
+  return out;
+}
+
+void Store::save_training(uint64_t job, uint32_t tile, uint32_t pass, const std::string& records) {
+  WriteLock lock(write_mu_);
+  Stmt(db_, prepared("INSERT OR REPLACE INTO training(job, pass, tile, data) VALUES(?, ?, ?, ?)"))
+      .bind(int64_t(job)).bind(int64_t(pass)).bind(int64_t(tile)).blob(records).step();
+}
+
+void Store::for_each_training(uint64_t job, uint32_t pass, const std::function<void(std::string&&)>& fn) {
+  Stmt st(rd_, "SELECT data FROM training WHERE job = ? AND pass = ? ORDER BY tile");
+  st.bind(int64_t(job)).bind(int64_t(pass));
+  while (st.step()) fn(st.s(0));
+}
+
 void Store::for_each_result(uint64_t job, const std::function<void(ResultRow&&)>& fn, bool with_data) {
   Stmt st(rd_, with_data ? "SELECT tile, pass, worker, data FROM results WHERE job = ? ORDER BY pass, tile"
                          : "SELECT tile, pass, worker, '' FROM results WHERE job = ? ORDER BY pass, tile");
@@ -365,6 +403,8 @@ void Store::delete_job(uint64_t id, double now) {
     Stmt(db_, "DELETE FROM results WHERE job = ?").bind(int64_t(id)).step();
     Stmt(db_, "DELETE FROM checkpoints WHERE job = ?").bind(int64_t(id)).step();
     Stmt(db_, "DELETE FROM pass_plans WHERE job = ?").bind(int64_t(id)).step();
+    Stmt(db_, "DELETE FROM guides WHERE job = ?").bind(int64_t(id)).step();
+    Stmt(db_, "DELETE FROM training WHERE job = ?").bind(int64_t(id)).step();
     Stmt(db_, "DELETE FROM leases WHERE job = ?").bind(int64_t(id)).step();
     Stmt(db_, "DELETE FROM jobs WHERE id = ?").bind(int64_t(id)).step();
   });

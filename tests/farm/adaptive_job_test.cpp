@@ -34,14 +34,6 @@ Film local_adaptive_render(const Scene& scene, uint32_t seed) {
   return render(scene, rs);
 }
 
-int64_t differing(const Film& a, const Film& b) {
-  int64_t n = 0;
-  const TileRect& w = a.window();
-  for (int y = w.y0; y < w.y1; ++y)
-    for (int x = w.x0; x < w.x1; ++x) n += std::memcmp(&a.pixel({x, y}), &b.pixel({x, y}), sizeof(PixelSums)) != 0;
-  return n;
-}
-
 FilmTile render_job_unit(const Scene& scene, const JobState& job, size_t u, uint32_t seed) {
   FilmTile tile;
   if (std::optional<PassSamples> s = job.lease_samples(u)) render_tile(scene, job.rect(u), *s, seed, tile);
@@ -52,14 +44,8 @@ FilmTile render_job_unit(const Scene& scene, const JobState& job, size_t u, uint
 TEST(AdaptiveJob, UnitsInAnyOrderStitchToTheLocalAdaptiveRender) {
   LoadResult loaded = load_fixture_scene();
   const Scene& scene = *loaded.scene;
-  JobPlan plan;
-  plan.settings.spp = kSpp;
-  plan.settings.tile_size = 8;
-  plan.settings.seed = 6;
+  JobPlan plan = plan_for(scene, kSpp, 8, 6);
   plan.settings.adaptive = true;
-  plan.window = film_window(scene.film);
-  plan.full_width = scene.film.width;
-  plan.full_height = scene.film.height;
   JobState job(1, plan, "adaptive", 0, 0);
   ASSERT_EQ(job.num_passes(), 6u);
 
@@ -99,43 +85,17 @@ TEST(AdaptiveJob, UnitsInAnyOrderStitchToTheLocalAdaptiveRender) {
   EXPECT_EQ(differing(job.film(), local_adaptive_render(scene, 6)), 0);
 }
 
-Image pfm_image(const std::string& bytes) {
-  TempDir dir;
-  const std::string path = (dir.path / "image.pfm").string();
-  std::ofstream(path, std::ios::binary) << bytes;
-  return read_image(path);
-}
-
 // A coordinator stopped and started again every few results (its film rebuilt from checkpoints
 // that may hold passes after a barrier) still decides the same counts.
 TEST(AdaptiveJob, RestartsAtAnyPointGiveTheLocalAdaptiveImage) {
   TempDir dir;
   LoadResult loaded = load_fixture_scene();
   const json settings = {{"tile_size", 8}, {"seed", 9}, {"spp", kSpp}, {"adaptive", true}};
-  uint64_t id = 0, worker = 0;
   int restarts = 0, adaptive_leases = 0;
-  bool more = true;
-  for (int round = 0; more; ++round) {
-    Coordinator c(options(dir));
-    if (round == 0) {
-      worker = add_worker(c, "w");
-      auto job = submit(c, settings, bundle());
-      ASSERT_TRUE(job.ok()) << job.status.detail;
-      id = job.value.jobs.at(0).id;
-    } else {
-      ++restarts;
-    }
-    for (int i = 0; i < 3 + round % 4 && more; ++i) {
-      json l = lease_json(c.lease(worker, 0));
-      if (!l.is_object()) {
-        more = false;
-        break;
-      }
-      adaptive_leases += l.contains("count");
-      auto up = c.upload_result(worker, l["id"], render_unit(l, *loaded.scene, 9));
-      ASSERT_TRUE(up.ok()) << up.status.detail;
-    }
-  }
+  const uint64_t id = render_with_restarts(dir, settings, bundle(), [&](Coordinator&, const json& l) {
+    adaptive_leases += l.contains("count");
+    return render_unit(l, *loaded.scene, 9);
+  }, restarts);
   Coordinator c(options(dir));
   ASSERT_EQ(c.job_status(id).value.state, "done");
   EXPECT_GT(restarts, 5);

@@ -6,11 +6,16 @@
 #include "tessera/farm/bundle.h"
 #include "tessera/farm/job_scene.h"
 #include "tessera/farm/tile_result.h"
+#include "tessera/image/image.h"
 #include "tessera/render/renderer.h"
 #include "tessera/scene/load_context.h"
 #include "tessera/scene/scene_desc.h"
 #include "tessera/server/coordinator.h"
 #include "test_support.h"
+
+#include <cstring>
+#include <fstream>
+#include <functional>
 
 namespace tessera::test {
 
@@ -74,6 +79,68 @@ inline bool deliver_one(server::Coordinator& c, uint64_t worker, const Scene& sc
   auto up = c.upload_result(worker, l["id"], render_unit(l, scene, seed));
   EXPECT_TRUE(up.ok()) << up.status.detail;
   return true;
+}
+
+/// Submits `settings` with `bundle` to a coordinator in `dir` and delivers its units (rendered by
+/// `render`, given the coordinator and the lease) until the job is done, stopping the coordinator
+/// and starting it again every 2 to 6 results. Returns the job's id; `restarts` counts them.
+inline uint64_t render_with_restarts(const TempDir& dir, const nlohmann::json& settings, const std::string& bundle,
+                                     const std::function<std::string(server::Coordinator&, const nlohmann::json&)>& render,
+                                     int& restarts) {
+  uint64_t id = 0, worker = 0;
+  restarts = 0;
+  for (int round = 0; round < 500; ++round) {
+    server::Coordinator c(options(dir));
+    if (round == 0) {
+      worker = add_worker(c, "w");
+      auto job = submit(c, settings, bundle);
+      if (!job.ok()) {
+        ADD_FAILURE() << job.status.detail;
+        return 0;
+      }
+      id = job.value.jobs.at(0).id;
+    } else {
+      ++restarts;
+    }
+    for (int i = 0; i < 2 + round % 5; ++i) {
+      if (c.job_status(id).value.state == "done") return id;
+      nlohmann::json l = lease_json(c.lease(worker, 5));  // (waits while a pass is being opened)
+      if (!l.is_object()) break;
+      auto up = c.upload_result(worker, l["id"], render(c, l));
+      EXPECT_TRUE(up.ok()) << up.status.detail;
+    }
+  }
+  ADD_FAILURE() << "the job does not finish";
+  return id;
+}
+
+/// A job's plan for a scene loaded in the test (its film), without the coordinator.
+inline JobPlan plan_for(const Scene& scene, int spp, int tile_size, uint32_t seed) {
+  JobPlan plan;
+  plan.settings.spp = spp;
+  plan.settings.tile_size = tile_size;
+  plan.settings.seed = seed;
+  plan.window = film_window(scene.film);
+  plan.full_width = scene.film.width;
+  plan.full_height = scene.film.height;
+  return plan;
+}
+
+/// Pixels whose sums differ in any bit (films of one window).
+inline int64_t differing(const Film& a, const Film& b) {
+  int64_t n = 0;
+  const TileRect& w = a.window();
+  for (int y = w.y0; y < w.y1; ++y)
+    for (int x = w.x0; x < w.x1; ++x) n += std::memcmp(&a.pixel({x, y}), &b.pixel({x, y}), sizeof(PixelSums)) != 0;
+  return n;
+}
+
+/// A job image's PFM bytes (Coordinator::job_image), decoded.
+inline Image pfm_image(const std::string& bytes) {
+  TempDir dir;
+  const std::string path = (dir.path / "image.pfm").string();
+  std::ofstream(path, std::ios::binary) << bytes;
+  return read_image(path);
 }
 
 }  // namespace tessera::test

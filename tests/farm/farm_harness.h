@@ -236,6 +236,9 @@ inline Image local_render(const std::string& scene, const JobSettings& settings)
   rs.tile_size = 32;  // deliberately not the farm's tile size
   rs.target_error = settings.target_error;
   rs.adaptive = settings.adaptive;
+  const IntegratorSettings& integrator = loaded.loaded.scene->integrator;
+  rs.guiding = settings.guiding.value_or(integrator.guiding.has_value());
+  if (integrator.guiding) rs.guiding_settings = *integrator.guiding;
   return render(*loaded.loaded.scene, rs).to_image();
 }
 

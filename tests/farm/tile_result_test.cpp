@@ -50,6 +50,11 @@ TEST(TileResult, RoundTripsEveryBit) {
   ASSERT_EQ(out.film.pixels().size(), in.film.pixels().size());
   EXPECT_EQ(std::memcmp(out.film.pixels().data(), in.film.pixels().data(), in.film.pixels().size() * sizeof(PixelSums)), 0);
   std::printf("13x9 tile: %zu bytes raw, %zu compressed\n", size_t(13 * 9 * 56 + 128), bytes.size());
+  EXPECT_TRUE(out.training.empty());
+  // A guide-training unit's records travel with it, byte for byte.
+  in.training = std::string("TSDR\0\x01\0\0", 8) + std::string(300, '\x07');
+  ASSERT_TRUE(decode_tile_result(encode_tile_result(in), out, error)) << error;
+  EXPECT_EQ(out.training, in.training);
 }
 
 TEST(TileResult, RefusesDamage) {
@@ -80,7 +85,7 @@ TEST(TileResult, RefusesDamage) {
   std::printf("flipped bytes: %d refused, %d harmless framing\n", refused, harmless);
   // A rect larger than the limit is refused before anything is allocated for it.
   EXPECT_FALSE(decode_tile_result(bytes, out, error, 100));
-  EXPECT_NE(error.find("implausible"), std::string::npos) << error;
+  EXPECT_NE(error.find("over the limit"), std::string::npos) << error;
 }
 
 bool same_result(const TileResult& a, const TileResult& b) {
@@ -98,7 +103,7 @@ std::string zstd_frame(std::string_view raw) {
 TEST(TileResult, StoredUncompressedRoundTripsAndIsChecked) {
   const TileResult in = sample_result();
   const std::string raw = encode_tile_result(in, kUncompressed);
-  EXPECT_EQ(raw.size(), size_t(96 + 13 * 9 * 56 + kTileResultDigestBytes));
+  EXPECT_EQ(raw.size(), size_t(96 + 13 * 9 * 56 + 8 + kTileResultDigestBytes));
   EXPECT_EQ(raw.substr(0, 4), "TSTR");
   TileResult out;
   std::string error;
@@ -117,7 +122,7 @@ TEST(TileResult, StoredUncompressedRoundTripsAndIsChecked) {
 TEST(TileResult, ReadsVersionOneWithSha256) {
   const TileResult in = sample_result();
   std::string v1 = encode_tile_result(in, kUncompressed);
-  v1.resize(v1.size() - kTileResultDigestBytes);
+  v1.resize(v1.size() - kTileResultDigestBytes - 8);  // (and without version 3's training records)
   const uint32_t version = 1;
   std::memcpy(v1.data() + 4, &version, 4);
   const Sha256Digest digest = sha256(v1);
@@ -129,9 +134,9 @@ TEST(TileResult, ReadsVersionOneWithSha256) {
   v1[300] ^= 0x04;
   EXPECT_FALSE(decode_tile_result(v1, out, error));
   EXPECT_NE(error.find("checksum"), std::string::npos) << error;
-  std::memcpy(v1.data() + 4, "\x03\0\0\0", 4);
+  std::memcpy(v1.data() + 4, "\x09\0\0\0", 4);
   EXPECT_FALSE(decode_tile_result(v1, out, error));
-  EXPECT_NE(error.find("version 3"), std::string::npos) << error;
+  EXPECT_NE(error.find("version 9"), std::string::npos) << error;
 }
 
 TEST(TileResult, ConcatenatedFramesDecodeAsOne) {
@@ -151,9 +156,9 @@ TEST(TileResult, ConcatenatedFramesDecodeAsOne) {
   EXPECT_FALSE(decode_tile_result(first_two, out, error));
   EXPECT_FALSE(decode_tile_result(bytes + zstd_frame(std::string_view(raw).substr(3100)), out, error));
   EXPECT_FALSE(decode_tile_result(bytes + "junk", out, error));
-  // The size limit counts every frame.
+  // The rectangle's limit holds however the bytes were framed.
   EXPECT_FALSE(decode_tile_result(bytes, out, error, 100));
-  EXPECT_NE(error.find("implausible"), std::string::npos) << error;
+  EXPECT_NE(error.find("over the limit"), std::string::npos) << error;
 }
 
 }  // namespace

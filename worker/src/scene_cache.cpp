@@ -1,6 +1,7 @@
 #include "tessera/worker/scene_cache.h"
 
 #include "tessera/farm/bundle.h"
+#include "tessera/farm/guide_artifact.h"
 #include "tessera/farm/job_scene.h"
 #include "tessera/farm/sha256.h"
 
@@ -67,7 +68,29 @@ std::shared_ptr<const CachedScene> SceneCache::load(const Lease& lease, const cl
 }
 
 std::shared_ptr<const CachedScene> SceneCache::get(const Lease& lease, const client::FarmApi& api) {
-  const std::string key = scene_cache_key(lease.settings, lease.scene_file);
+  return cached(scene_cache_key(lease.settings, lease.scene_file), [&] { return load(lease, api); });
+}
+
+std::shared_ptr<const CachedScene> SceneCache::guide(const Lease& lease, const client::FarmApi& api) {
+  const std::string& hash = lease.guide.value().hash;
+  return cached("guide " + hash, [&] {
+    client::HttpReply r = api.download_guide(hash);
+    if (!r.ok()) throw std::runtime_error("cannot download guide " + hash + ": " + r.describe());
+    if (sha256_hex(r.body) != hash) throw std::runtime_error("guide " + hash + " arrived corrupt (hash mismatch)");
+    auto tree = std::make_unique<SpatialTree>();
+    std::string error;
+    if (!decode_guide(r.body, *tree, error)) throw std::runtime_error(error);
+    auto out = std::make_shared<CachedScene>();
+    out->bytes = tree->bytes();
+    out->guide = std::move(tree);
+    spdlog::info("downloaded guide {} of job {} ({} bytes, {} MB in memory)", hash.substr(0, 12), lease.job_id,
+                 r.body.size(), out->bytes >> 20);
+    return out;
+  });
+}
+
+std::shared_ptr<const CachedScene> SceneCache::cached(const std::string& key,
+                                                      const std::function<std::shared_ptr<const CachedScene>()>& load) {
   std::promise<std::shared_ptr<const CachedScene>> promise;
   std::shared_future<std::shared_ptr<const CachedScene>> future;
   bool loader = false;
@@ -86,7 +109,7 @@ std::shared_ptr<const CachedScene> SceneCache::get(const Lease& lease, const cli
   }
   if (loader) {
     try {
-      promise.set_value(load(lease, api));
+      promise.set_value(load());
     } catch (...) {
       // A failed load is not cached: the next lease tries again (the bundle may have been fixed).
       promise.set_exception(std::current_exception());

@@ -176,9 +176,10 @@ std::optional<Lease> Worker::process(const Lease& lease) {
     dropped_.erase(lease.id);
     return dropped;
   };
-  std::shared_ptr<const CachedScene> scene;
+  std::shared_ptr<const CachedScene> scene, guide;
   try {
     scene = cache_.get(lease, api_);
+    if (lease.guide) guide = cache_.guide(lease, api_);
   } catch (const std::exception& e) {
     finish();
     ++stats_.failures;
@@ -186,7 +187,7 @@ std::optional<Lease> Worker::process(const Lease& lease) {
     (void)api_.fail_lease(worker_id_.load(), lease.id, e.what());
     return std::nullopt;
   }
-  TileResult result = render_lease(*scene->scene, lease);
+  TileResult result = render_lease(*scene->scene, lease, guide ? guide->guide.get() : nullptr);
   ++stats_.passes_rendered;
   const bool dropped = finish();
   if (dropped) return std::nullopt;

@@ -102,7 +102,7 @@ class PathIntegrator final : public Integrator {
       }
       if (!surface_step(scene, path, si, media, sampler, counters)) break;
     }
-    if (path.records) path.records->commit(*guide->tree, path.L, sampler);
+    if (path.records) path.records->commit(*guide->records, path.L, sampler);
     return path.L;
   }
 

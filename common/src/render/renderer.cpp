@@ -84,10 +84,11 @@ void render_tile(const Scene& scene, const TileRect& rect, uint32_t sample_begin
   render_tile(scene, rect, PassSamples::uniform(rect, sample_begin, sample_end), seed, tile);
 }
 
-void render_tile(const Scene& scene, const TileRect& rect, const PassSamples& samples, uint32_t seed, FilmTile& tile) {
+void render_tile(const Scene& scene, const TileRect& rect, const PassSamples& samples, uint32_t seed, FilmTile& tile,
+                 const PathGuide* guide) {
   TESSERA_CHECK(samples.rect.contains(rect));
   auto integrator = make_integrator(scene.integrator);
-  render_tile_with(scene, *integrator, scene.film.filter.get(), rect, samples, seed, nullptr, tile);
+  render_tile_with(scene, *integrator, scene.film.filter.get(), rect, samples, seed, guide, tile);
 }
 
 Film render(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress,
@@ -119,7 +120,8 @@ Film render(const Scene& scene, const RenderSettings& settings, const ProgressCa
     for (size_t p = 0; p < passes.size(); ++p) {
       prog.pass = int(p);
       // A pass samples with what earlier passes learned, and trains if it is a training pass.
-      PathGuide guide{tree ? &*tree : nullptr, trained > 0, guiding_trains_pass(passes, p, uint32_t(settings.spp))};
+      SpatialTree* pass_tree = tree ? &*tree : nullptr;
+      PathGuide guide{pass_tree, pass_tree, trained > 0, guiding_trains_pass(passes, p, uint32_t(settings.spp))};
       const PathGuide* pass_guide = guide.tree && (guide.sample || guide.train) ? &guide : nullptr;
       const PassSamples samples = plan_pass(film, taken, begin, passes[p], uint32_t(settings.spp),
                                             settings.adaptive ? &settings.adaptive_settings : nullptr);
@@ -151,6 +153,10 @@ Film render(const Scene& scene, const RenderSettings& settings, const ProgressCa
     stats->counters = counters;
     stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     stats->spp_done = prog.samples_done;
+    if (tree) {
+      stats->guide_leaves = tree->leaf_count();
+      stats->guide_bytes = tree->bytes();
+    }
     stats->noise_estimate = settings.target_error > 0 ? (prog.samples_done == uint32_t(settings.spp) ? estimate_noise(film).rel_mse : noise) : 0;
   }
   return film;

@@ -33,6 +33,7 @@ class BsdfFractionLoss {
   bool operator==(const BsdfFractionLoss& other) const = default;
 
  private:
+  friend struct TreeIo;  // tree_io.h
   std::array<int64_t, kCandidates> loss_{};
   uint64_t records_ = 0;  // records with weight > 0
 };

@@ -79,6 +79,7 @@ class DirectionalTree {
   // Quadrant i covers x in [i&1 ? 0.5 : 0, ...) and y in [i&2 ? 0.5 : 0, ...) of its node.
   static int quadrant(Vec2& p);
   uint64_t build_node(uint32_t n);
+  friend struct TreeIo;  // tree_io.h
   void refine_into(DirectionalTree& out, uint32_t out_node, const Node* node, double scale, uint64_t energy,
                    int depth, double threshold, bool keep_sums) const;
 

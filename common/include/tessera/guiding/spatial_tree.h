@@ -48,6 +48,7 @@ class SpatialTree {
  public:
   /// One leaf over `bounds`, made a cube about its centre (so cuts halve its longest side first).
   explicit SpatialTree(const Bounds3& bounds, float bsdf_fraction = 0.5f);
+  SpatialTree() = default;  // (empty: to be read, tree_io.h)
 
   /// The leaf whose region holds `p` (a point outside the bounds goes to the nearest region).
   uint32_t leaf_of(Vec3 p) const;
@@ -91,6 +92,7 @@ class SpatialTree {
   };
   void split(uint32_t node);
   static size_t leaf_bytes(const Leaf& leaf);
+  friend struct TreeIo;  // tree_io.h
 
   Bounds3 bounds_;
   std::vector<Node> nodes_;

@@ -26,9 +26,10 @@ class Sampler;
 
 /// What a pass asks of the path tracer (null: no guiding at all).
 struct PathGuide {
-  SpatialTree* tree = nullptr;
-  bool sample = false;        // guide directions with the tree's learned distributions
-  bool train = false;         // record the pass's radiance into the tree
+  const SpatialTree* tree = nullptr;  // the learned distributions, and the leaves records go to
+  SpatialTree* records = nullptr;     // where training records go: `tree`, or a recorder of it (tree_io.h)
+  bool sample = false;                // guide directions with the tree's learned distributions
+  bool train = false;                 // record the pass's radiance into `records`
 };
 
 /// The vertices of one path that sampled a direction to record, and at the path's end the

@@ -11,6 +11,7 @@
 #include "tessera/guiding/spatial_tree.h"
 #include "tessera/render/adaptive.h"
 #include "tessera/render/film.h"
+#include "tessera/render/path_guide.h"
 #include "tessera/render/scene.h"
 
 #include <cstdint>
@@ -46,6 +47,7 @@ struct RenderStats {
   double seconds = 0;
   uint32_t spp_done = 0;      // samples per pixel rendered (less than spp when a target stopped it)
   double noise_estimate = 0;  // estimated relMSE of the result (only computed with a target)
+  size_t guide_leaves = 0, guide_bytes = 0;  // the learned SD-tree, when guided
 };
 
 struct RenderProgress {
@@ -72,8 +74,10 @@ std::vector<TileRect> make_tiles(const TileRect& window, int tile_size);
 void render_tile(const Scene& scene, const TileRect& rect, uint32_t sample_begin, uint32_t sample_end,
                  uint32_t seed, FilmTile& tile);
 
-/// Renders, for every pixel of `rect`, the samples `samples` gives it (samples.rect contains rect).
-void render_tile(const Scene& scene, const TileRect& rect, const PassSamples& samples, uint32_t seed, FilmTile& tile);
+/// Renders, for every pixel of `rect`, the samples `samples` gives it (samples.rect contains rect),
+/// guided by `guide` when it is given (a farm worker's unit of a guided job).
+void render_tile(const Scene& scene, const TileRect& rect, const PassSamples& samples, uint32_t seed, FilmTile& tile,
+                 const PathGuide* guide = nullptr);
 
 /// Renders the scene's crop window with settings.spp samples per pixel.
 Film render(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress = {},

@@ -6,6 +6,7 @@
 
 #include "tessera/farm/protocol.h"
 #include "tessera/farm/tile_result.h"
+#include "tessera/guiding/spatial_tree.h"
 #include "tessera/scene/load_context.h"
 
 #include <string>
@@ -22,6 +23,12 @@ struct JobPlan {
   int full_width = 0, full_height = 0;
   bool ldr = false;              // ldrfilm: PNG output uses gamma/exposure below
   float gamma = -1.f, exposure = 0.f;
+  /// A guided job: the SD-tree as render() starts it (over the scene's bounds) and its settings.
+  struct Guide {
+    Bounds3 bounds;
+    GuidingSettings settings;
+  };
+  std::optional<Guide> guide;
 };
 
 struct LoadedJobScene {
@@ -44,8 +51,9 @@ JobPlan make_job_plan(const std::string& bundle_dir, const std::string& scene_fi
 /// Sets `out` to the lease's unit (job, tile, pass, samples) with a zero film of its rectangle,
 /// reusing its storage: a result about to be filled.
 void begin_tile_result(const Lease& lease, TileResult& out);
-/// Renders a lease's unit (what a worker does with it), timed.
-TileResult render_lease(const Scene& scene, const Lease& lease);
+/// Renders a lease's unit (what a worker does with it), timed. A guided lease needs its guide
+/// (Lease::guide, decoded): a unit that trains returns its training records with the result.
+TileResult render_lease(const Scene& scene, const Lease& lease, const SpatialTree* guide = nullptr);
 
 nlohmann::json to_json(const JobPlan& p);
 [[nodiscard]] bool job_plan_from_json(const nlohmann::json& j, JobPlan& out, std::string& error);

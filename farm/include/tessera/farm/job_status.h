@@ -38,6 +38,13 @@ struct JobStatus {
   double target_error = 0;
   uint32_t spp_done = 0;  // complete passes' samples per pixel
   bool stopped_at_target = false;
+  /// A guided job's learned tree: guides stored so far (the first, then one per training pass
+  /// done), and the latest one's size in memory.
+  struct Guide {
+    uint32_t iterations = 0;
+    uint64_t leaves = 0, bytes = 0;
+  };
+  std::optional<Guide> guide;
   // From the lease log; absent when it could not be read.
   std::optional<uint64_t> leases_issued, reissued_acknowledged_passes;
 };

@@ -80,6 +80,15 @@ struct Lease {
   JobSettings settings;          // the job's, with spp/width/height resolved
   std::string scene_file;        // resolved XML path inside the bundle
   std::vector<std::string> files;  // bundle files the scene references (the worker unpacks only these)
+  /// A unit of a guided job's pass that samples or trains: the guide it renders with (GET
+  /// /api/v1/guides/HASH), learned over `iteration` training passes, and whether it trains.
+  struct Guide {
+    std::string hash;  // SHA-256 hex of the guide's bytes (guide_artifact.h)
+    uint32_t iteration = 0;
+    bool train = false;
+    bool operator==(const Guide&) const = default;
+  };
+  std::optional<Guide> guide;
 };
 
 nlohmann::json to_json(const Lease& l);

@@ -6,8 +6,9 @@
 //   u64 job id, u32 tile index, u32 pass index, i32 x0 y0 x1 y1, u32 sample_begin, sample_end,
 //   u64 samples, camera_rays, bounce_rays, shadow_rays, nonfinite, f64 render seconds,
 //   per pixel (row-major over the rect): f64 sum[3], f64 sum_sq[3], u64 count,
-//   16-byte XXH3-128 checksum of everything above (big-endian canonical form); format version 1,
-//   still read, ended in a 32-byte SHA-256 instead.
+//   u64 n, n bytes of training records (guiding/tree_io.h; n = 0 unless the unit trains a guide),
+//   16-byte XXH3-128 checksum of everything above (big-endian canonical form). Format version 2,
+//   still read, has no training records; version 1 also ended in a 32-byte SHA-256 instead.
 // The coordinator adds decoded tiles to its Film exactly as render() does, so the stitched image is
 // bit-identical to a local render (render/renderer.h).
 #pragma once
@@ -26,7 +27,11 @@ struct TileResult {
   uint32_t sample_begin = 0, sample_end = 0;
   double seconds = 0;  // time the worker spent rendering it
   FilmTile film;       // rect, sums and counters
+  std::string training;  // a guide-training unit's records (guiding/tree_io.h); else empty
 };
+
+/// Training records larger than this are refused (a unit's records are far smaller than its guide).
+inline constexpr size_t kMaxTrainingBytes = size_t(64) << 20;
 
 /// Bytes of the checksum that ends a result's uncompressed bytes.
 inline constexpr size_t kTileResultDigestBytes = 16;

@@ -83,6 +83,8 @@ class Coordinator {
   Result<std::string> scene_bundle_path(const std::string& hash);
   /// The stored bundle's bytes (what workers download).
   Result<std::string> scene_bundle(const std::string& hash);
+  /// A guided job's stored guide (guide_artifact.h bytes) by its SHA-256.
+  Result<std::string> guide(const std::string& hash);
 
   // Jobs. `bundle` non-empty: uploaded in the same request (the settings' scene may be empty).
   // With "frames": "A-B" (or [A, B]) in the settings, one job per frame N in A..B, each with

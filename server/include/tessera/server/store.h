@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <set>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -110,6 +111,17 @@ class Store {
   void save_pass_plan(uint64_t job, uint32_t pass, const std::string& data);
   /// Calls `fn(pass, bytes)` for every stored pass plan of `job`, in pass order.
   void for_each_pass_plan(uint64_t job, const std::function<void(uint32_t, std::string&&)>& fn);
+  /// A guided job's tree of iteration `iteration` is stored (its file) under `hash`; the training
+  /// records of the passes before it are no longer needed and are dropped.
+  void save_guide(uint64_t job, uint32_t iteration, const std::string& hash);
+  /// The job's stored trees' hashes, by iteration.
+  std::vector<std::string> guides(uint64_t job);
+  /// Every job's (a guide file no job names is deleted by retention).
+  std::set<std::string> guide_hashes();
+  /// Stores a training unit's records (guiding/tree_io.h bytes) until its pass's tree is stored.
+  void save_training(uint64_t job, uint32_t tile, uint32_t pass, const std::string& records);
+  /// Calls `fn(bytes)` for each stored training record of the job's pass `pass`, by tile.
+  void for_each_training(uint64_t job, uint32_t pass, const std::function<void(std::string&&)>& fn);
   /// Leases issued for a pass after that pass had been acknowledged (should be 0: the measure the
   /// restart test reads).
   uint64_t reissued_after_ack(uint64_t job);

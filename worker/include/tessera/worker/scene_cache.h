@@ -1,13 +1,16 @@
 // A worker's scenes: bundles downloaded once (verified by hash) into the cache directory, only
 // the files a job's scene references unpacked, and loaded scenes (with their BVH) kept across
-// tiles and jobs, least recently used evicted beyond a memory budget.
+// tiles and jobs, least recently used evicted beyond a memory budget. Guided jobs' guides
+// (guide_artifact.h) are downloaded once each and kept under the same budget.
 #pragma once
 
 #include "tessera/farm/protocol.h"
+#include "tessera/guiding/spatial_tree.h"
 #include "tessera/render/scene.h"
 #include "tessera/client/farm_api.h"
 
 #include <cstdint>
+#include <functional>
 #include <future>
 #include <list>
 #include <map>
@@ -19,7 +22,8 @@ namespace tessera::farm {
 
 struct CachedScene {
   std::unique_ptr<Scene> scene;
-  uint64_t bytes = 0;  // estimate: meshes, BVH, images
+  std::unique_ptr<const SpatialTree> guide;  // an entry for a guide holds it instead of a scene
+  uint64_t bytes = 0;  // estimate: meshes, BVH, images; or the guide's
 };
 
 class SceneCache {
@@ -30,6 +34,8 @@ class SceneCache {
   /// for the same scene wait for one load. Throws std::runtime_error (download/bundle problems) or
   /// the loader's SceneError/UnsupportedError.
   std::shared_ptr<const CachedScene> get(const Lease& lease, const client::FarmApi& api);
+  /// The guide a guided lease renders with (lease.guide set), fetched and checked on first use.
+  std::shared_ptr<const CachedScene> guide(const Lease& lease, const client::FarmApi& api);
 
   size_t loaded_scenes() const;
   /// Number of bundle downloads so far (a test checks each bundle is fetched once).
@@ -38,6 +44,8 @@ class SceneCache {
  private:
   std::string bundle_file(const Lease& lease, const client::FarmApi& api);
   std::shared_ptr<const CachedScene> load(const Lease& lease, const client::FarmApi& api);
+  std::shared_ptr<const CachedScene> cached(const std::string& key,
+                                            const std::function<std::shared_ptr<const CachedScene>()>& load);
   void evict_locked();
 
   std::string dir_;

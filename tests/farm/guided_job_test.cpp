@@ -1,0 +1,162 @@
+// Path guiding on the farm: the coordinator makes each training pass's tree from every tile's
+// training records, hands it out as a hashed guide, and the stitched image is bit for bit
+// render()'s with guiding, for any order of results and across restarts.
+#include "coordinator_fixture.h"
+#include "job_state.h"
+#include "tessera/farm/guide_artifact.h"
+#include "tessera/farm/sha256.h"
+#include "tessera/image/image.h"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <random>
+
+namespace tessera::test {
+namespace {
+
+using nlohmann::json;
+using server::Coordinator;
+using server::JobState;
+
+// 24 spp: passes 1, 2, 4, 8, 9; those ending within 12 samples (1, 3, 7) train, the rest sample.
+constexpr int kSpp = 24;
+
+// A room lit by a small sphere and the sky through its open side, guided by its integrator with a
+// fixed BSDF fraction (so every learned tree shows in the image).
+constexpr const char* kGuidedXml = R"(<scene version="0.6.0">
+  <integrator type="guided_path"><integer name="maxDepth" value="6"/>
+    <string name="budgetType" value="spp"/><float name="budget" value="24"/>
+    <string name="sampleCombination" value="discard"/><string name="bsdfSamplingFractionLoss" value="none"/>
+  </integrator>
+  <sensor type="perspective"><float name="fov" value="60"/>
+    <transform name="toWorld"><lookat origin="0,1,-2.5" target="0,0.8,0" up="0,1,0"/></transform>
+    <sampler type="independent"><integer name="sampleCount" value="4"/></sampler>
+    <film type="hdrfilm"><integer name="width" value="20"/><integer name="height" value="12"/></film>
+  </sensor>
+  <shape type="rectangle"><transform name="toWorld"><rotate x="1" angle="-90"/><scale value="3"/></transform></shape>
+  <shape type="rectangle"><transform name="toWorld"><scale value="3"/><translate z="2"/></transform></shape>
+  <shape type="sphere"><point name="center" x="0.6" y="0.5" z="0.5"/><float name="radius" value="0.4"/></shape>
+  <shape type="sphere"><point name="center" x="-1" y="2" z="1.5"/><float name="radius" value="0.1"/>
+    <emitter type="area"><rgb name="radiance" value="40,36,30"/></emitter></shape>
+  <emitter type="constant"><rgb name="radiance" value="0.2,0.25,0.3"/></emitter>
+</scene>)";
+
+LoadResult load_fixture_scene() { return load_scene(parse_scene_string(kGuidedXml, "scene.xml"), LoadOptions{}); }
+
+std::string guided_bundle() {
+  TempDir src;
+  src.write("scene.xml", kGuidedXml);
+  return pack_bundle(src.path.string(), {"scene.xml"});
+}
+
+Film local_guided_render(const Scene& scene, uint32_t seed, bool adaptive = false) {
+  RenderSettings rs;
+  rs.spp = kSpp;
+  rs.seed = seed;
+  rs.tile_size = 7;  // not the job's
+  rs.guiding = true;
+  rs.guiding_settings = scene.integrator.guiding.value();
+  rs.adaptive = adaptive;
+  return render(scene, rs);
+}
+
+// What the coordinator and a worker do with a guide, in process: stored by its hash, decoded.
+struct Guides {
+  std::map<std::string, SpatialTree> by_hash;
+  void store_new(JobState& job) {
+    while (auto made = job.take_tree_to_store()) {
+      const std::string bytes = encode_guide(*made->second), hash = sha256_hex(bytes);
+      std::string error;
+      ASSERT_TRUE(decode_guide(bytes, by_hash[hash], error)) << error;
+      EXPECT_TRUE(by_hash[hash] == *made->second) << "a guide decodes to the tree it encodes";
+      job.guide_stored(made->first, hash);
+    }
+  }
+};
+
+TEST(GuidedJob, UnitsInAnyOrderStitchToTheLocalGuidedRender) {
+  LoadResult loaded = load_fixture_scene();
+  const Scene& scene = *loaded.scene;
+  JobPlan plan = plan_for(scene, kSpp, 8, 4);
+  plan.guide = JobPlan::Guide{scene.bounds(), scene.integrator.guiding.value()};
+  JobState job(1, plan, "guided", 0, 0);
+  EXPECT_FALSE(job.next_unit()) << "nothing is leased before the first guide is stored";
+
+  Guides guides;
+  std::mt19937 rng(5);
+  int training_units = 0;
+  for (;;) {
+    guides.store_new(job);
+    std::vector<size_t> open;
+    while (std::optional<size_t> u = job.next_unit()) {
+      open.push_back(*u);
+      job.lease_started(*u);
+    }
+    if (open.empty()) break;
+    std::shuffle(open.begin(), open.end(), rng);
+    for (size_t u : open) {
+      Lease lease;
+      lease.rect = job.rect(u);
+      lease.sample_begin = job.sample_begin(u);
+      lease.sample_end = job.sample_end(u);
+      lease.settings.seed = 4;
+      lease.guide = job.lease_guide(u);
+      ASSERT_TRUE(lease.guide) << "every pass of a guided job samples or trains";
+      TileResult r = render_lease(scene, lease, &guides.by_hash.at(lease.guide->hash));
+      std::string error;
+      EXPECT_FALSE(job.check_training(u, lease.guide->train ? "" : "junk", error)) << "pass " << job.pass_of(u);
+      ASSERT_TRUE(job.check_training(u, r.training, error)) << error;
+      training_units += lease.guide->train;
+      job.lease_ended(u);
+      ASSERT_TRUE(job.add_result(u, std::move(r.film), 1, r.training));
+    }
+  }
+  ASSERT_TRUE(job.complete());
+  EXPECT_EQ(job.guide_iterations(), 4u) << "the first tree and one after each of 3 training passes";
+  EXPECT_EQ(training_units, 3 * 6);
+  const Film local = local_guided_render(scene, 4);
+  EXPECT_EQ(differing(job.film(), local), 0);
+  EXPECT_EQ(local.pixel({3, 3}).count, uint64_t(kSpp - 7)) << "the training passes are not in the image";
+}
+
+// Renders a lease as a worker does, fetching its guide from the coordinator.
+std::string render_guided_unit(Coordinator& c, const json& lease_json, const Scene& scene, uint32_t seed) {
+  Lease lease;
+  std::string error;
+  EXPECT_TRUE(lease_from_json(lease_json, lease, error)) << error;
+  lease.settings.seed = seed;
+  SpatialTree guide;
+  if (lease.guide) {
+    server::Result<std::string> bytes = c.guide(lease.guide->hash);
+    EXPECT_TRUE(bytes.ok()) << bytes.status.detail;
+    EXPECT_EQ(sha256_hex(bytes.value), lease.guide->hash);
+    EXPECT_TRUE(decode_guide(bytes.value, guide, error)) << error;
+  }
+  return encode_tile_result(render_lease(scene, lease, lease.guide ? &guide : nullptr));
+}
+
+// A coordinator stopped and started again every few results, in the middle of training (its
+// tree rebuilt from the stored guide and the training records of the pass in progress), with
+// adaptive sampling too.
+TEST(GuidedJob, RestartsDuringTrainingGiveTheLocalGuidedImage) {
+  TempDir dir;
+  LoadResult loaded = load_fixture_scene();
+  const json settings = {{"tile_size", 8}, {"seed", 7}, {"spp", kSpp}, {"adaptive", true}};  // (guided: the scene says)
+  int restarts = 0;
+  const uint64_t id = render_with_restarts(dir, settings, guided_bundle(), [&](Coordinator& c, const json& l) {
+    return render_guided_unit(c, l, *loaded.scene, 7);
+  }, restarts);
+  EXPECT_GT(restarts, 5);
+  Coordinator c(options(dir));
+  EXPECT_EQ(c.job_status(id).value.spp, kSpp);
+  const Image farm = pfm_image(c.job_image(id, "pfm").value.bytes);
+  const Image local = local_guided_render(*loaded.scene, 7, /*adaptive=*/true).to_image();
+  ASSERT_EQ(farm.values().size(), local.values().size());
+  EXPECT_TRUE(std::memcmp(farm.values().data(), local.values().data(), local.values().size() * sizeof(float)) == 0);
+}
+
+}  // namespace
+}  // namespace tessera::test
