@@ -20,9 +20,9 @@ bash tests/deploy/container_test.sh build || status=$?
 [ $status -eq 0 ] || [ $status -eq 77 ] || exit $status
 
 # Sanitizer build: the loader fuzz test, and the farm's decoders of untrusted bytes (bundles, tile
-# results, JSON settings) under AddressSanitizer/UBSan too; built for SSE2, so the BVH tests (against
-# brute force and Embree's answers) also cover the 4-wide nodes.
+# results, JSON settings, guides and training records) under AddressSanitizer/UBSan too; built for
+# SSE2, so the BVH tests (against brute force and Embree's answers) also cover the 4-wide nodes.
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTESSERA_SANITIZE=ON -DTESSERA_SIMD=sse2
-cmake --build build-asan -j"$jobs" --target loader_fuzz_test farm_test accel_test
+cmake --build build-asan -j"$jobs" --target loader_fuzz_test farm_test accel_test guiding_test
 ctest --test-dir build-asan --output-on-failure -L fuzz
-ctest --test-dir build-asan --output-on-failure -R '^(farm_test|accel_test)$'
+ctest --test-dir build-asan --output-on-failure -R '^(farm_test|accel_test|guiding_test)$'
