@@ -84,17 +84,14 @@ TileResult render_lease(const Scene& scene, const Lease& lease, const SpatialTre
   const PassSamples samples = lease.samples.count.empty()
                                   ? PassSamples::uniform(lease.rect, lease.sample_begin, lease.sample_end)
                                   : lease.samples;
-  if (lease.guide) {
-    if (!guide) throw std::invalid_argument("render_lease: a guided lease without its guide");
-    // Training goes into a recorder of the guide, whose nonzero sums travel with the result.
-    std::optional<SpatialTree> recorder;
-    if (lease.guide->train) recorder = make_recorder(*guide);
-    const PathGuide path_guide{guide, recorder ? &*recorder : nullptr, lease.guide->iteration > 0, lease.guide->train};
-    render_tile(scene, lease.rect, samples, lease.settings.seed, result.film, &path_guide);
-    if (recorder) result.training = write_records(*recorder);
-  } else {
-    render_tile(scene, lease.rect, samples, lease.settings.seed, result.film);
-  }
+  if (lease.guide && !guide) throw std::invalid_argument("render_lease: a guided lease without its guide");
+  // Training goes into a recorder of the guide, whose nonzero sums travel with the result.
+  std::optional<SpatialTree> recorder;
+  if (lease.guide && lease.guide->train) recorder = make_recorder(*guide);
+  std::optional<PathGuide> path_guide;
+  if (lease.guide) path_guide = PathGuide{guide, recorder ? &*recorder : nullptr, lease.guide->iteration > 0, lease.guide->train};
+  render_tile(scene, lease.rect, samples, lease.settings.seed, result.film, path_guide ? &*path_guide : nullptr);
+  if (recorder) result.training = write_records(*recorder);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return result;
 }

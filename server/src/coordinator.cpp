@@ -12,7 +12,6 @@
 #include <spdlog/spdlog.h>
 
 #include <filesystem>
-#include <fstream>
 
 namespace tessera::server {
 
@@ -92,8 +91,7 @@ Coordinator::Coordinator(CoordinatorOptions options) : impl_(std::make_unique<Im
       continue;
     }
     JobState& job = *s.jobs.emplace(row.id, s.rebuild_job(row)).first->second;
-    s.save_pass_plans(job);
-    s.save_guides(job);
+    s.save_decisions(job);
     passes += job.done_units();
     if (!is_terminal(job.phase) && job.complete()) {  // its last result landed before a crash
       (void)s.change_phase(job, JobPhase::Done);
@@ -227,6 +225,11 @@ std::string encode_checkpoint(uint64_t job, const JobState::Checkpoint& cp) {
   return encode_tile_result(sums, kUncompressed);
 }
 
+void Coordinator::Impl::save_decisions(JobState& job) {
+  save_pass_plans(job);
+  save_guides(job);
+}
+
 void Coordinator::Impl::save_pass_plans(JobState& job) {
   for (JobState::DecidedPass& d : job.take_new_plans()) {
     log_event(spdlog::level::info, "job.pass_planned", {{"job", job.id()}, {"pass", d.pass}, {"seconds", d.seconds}});
@@ -242,10 +245,13 @@ void Coordinator::Impl::save_pass_plans(JobState& job) {
 void Coordinator::Impl::restore_guide(JobState& job) {
   std::vector<std::string> hashes = store.guides(job.id());
   if (hashes.empty()) return;  // (not even its first tree was stored: it is made again)
-  std::ifstream in(guide_path(hashes.back()), std::ios::binary);
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string bytes, error;
+  try {
+    bytes = read_file(guide_path(hashes.back()));
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
   auto tree = std::make_shared<SpatialTree>();
-  std::string error;
   if (sha256_hex(bytes) != hashes.back() || !decode_guide(bytes, *tree, error))
     throw std::runtime_error("job " + std::to_string(job.id()) + ": its stored guide " + hashes.back() +
                              " is missing or corrupt " + error);

@@ -125,10 +125,11 @@ struct Coordinator::Impl {
   /// Under `mu`: appends the tile's checkpoint once `min_new` more passes are in its film (encoded
   /// by the writer, not under `mu`).
   void checkpoint_tile(JobState& job, uint32_t tile, uint32_t min_new);
-  /// Under `mu`: appends the adaptive passes the job decided since the last call to the store.
+  /// Under `mu`: stores what the job decided at its barriers since the last call, ahead of the
+  /// passes that depend on it: adaptive passes' counts (appended to the group commit) and a guided
+  /// job's new tree (encoded and written off the lock, then its row appended and its passes opened).
+  void save_decisions(JobState& job);
   void save_pass_plans(JobState& job);
-  /// Under `mu`: a guided job's new tree is encoded and written off the lock (background), then
-  /// its row appended and the passes that render with it opened.
   void save_guides(JobState& job);
   /// Rebuilding: the job's stored trees and the training records of the pass it trains next.
   void restore_guide(JobState& job);
@@ -232,6 +233,8 @@ double wall_seconds();
 /// Writes `bytes` to a temporary name, fsyncs, renames to `path` and fsyncs its directory: after a
 /// crash the file is either complete or absent. Throws (DiskFullError on a full disk).
 void write_file_durably(const std::string& path, const std::string& bytes);
+/// The whole file; throws std::runtime_error naming it when it cannot be read.
+std::string read_file(const std::string& path);
 
 /// A tile's checkpoint as stored: tile_result.h bytes (pass: its last pass; samples 0..sample_end).
 std::string encode_checkpoint(uint64_t job, const JobState::Checkpoint& cp);

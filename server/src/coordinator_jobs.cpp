@@ -56,9 +56,6 @@ void write_file_durably(const std::string& path, const std::string& bytes) {
   }
 }
 
-namespace {
-
-
 std::string read_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error("cannot read " + path);
@@ -66,11 +63,6 @@ std::string read_file(const std::string& path) {
   ss << in.rdbuf();
   return ss.str();
 }
-
-
-
-
-}  // namespace
 
 // Checked before the scene is loaded, so a flood of submissions costs no unpacking, and again
 // before the job is stored.
@@ -271,7 +263,7 @@ Result<JobStatus> Coordinator::Impl::add_job(const std::string& name, JobPlan pl
     std::lock_guard<std::mutex> lock(mu);
     --submissions_in_flight;
     status = status_of(*job);
-    save_guides(*job);
+    save_decisions(*job);
     jobs.emplace(id, std::move(job));
     work_cv.notify_all();
   }
@@ -473,8 +465,7 @@ Status Coordinator::retry_job(uint64_t id) {
   if (it == s.jobs.end()) return unknown_job(id);
   if (it->second->phase != JobPhase::Failed && it->second->phase != JobPhase::Cancelled)
     return not_ended(it->second->phase);  // (retried by another request meanwhile)
-  s.save_pass_plans(*job);
-  s.save_guides(*job);
+  s.save_decisions(*job);
   const uint64_t ticket = s.change_phase(*job, JobPhase::Queued);
   it->second = std::move(job);
   lock.unlock();

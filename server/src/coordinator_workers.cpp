@@ -273,8 +273,7 @@ void Coordinator::Impl::result_committed(bool durable, uint64_t job_id, size_t u
   }
   const uint64_t samples = job.unit_samples(unit);
   if (!job.add_result(unit, std::move(result.film), worker, result.training)) return;  // (a retry rebuilt it meanwhile)
-  save_pass_plans(job);
-  save_guides(job);
+  save_decisions(job);
   checkpoint_tile(job, job.tile_of(unit), 1);
   job.result_bytes += bytes;
   ++counters.done;

@@ -42,6 +42,7 @@ class JobGuide {
   bool made(uint32_t i) const { return made_ >= int64_t(i); }
   bool stored(uint32_t i) const { return i < hashes_.size(); }
   const std::string& hash(uint32_t i) const { return hashes_.at(i); }
+  uint32_t stored_count() const { return uint32_t(hashes_.size()); }
 
   /// Makes the next iteration's tree from the latest one and the records added to it (at the
   /// barrier of the pass after the training pass, which must be complete).

@@ -72,11 +72,7 @@ void JobState::guide_stored(uint32_t i, std::string hash) {
   advance_passes();
 }
 
-uint32_t JobState::guide_iterations() const {
-  uint32_t n = 0;
-  while (guide_ && guide_->stored(n)) ++n;
-  return n;
-}
+uint32_t JobState::guide_iterations() const { return guide_ ? guide_->stored_count() : 0; }
 
 uint64_t JobState::unit_samples(size_t unit) const {
   const uint32_t pass = pass_of(unit);

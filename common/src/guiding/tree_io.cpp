@@ -226,7 +226,12 @@ struct TreeIo {
   struct Records {
     std::vector<std::pair<uint32_t, uint64_t>> samples;
     std::vector<std::pair<uint32_t, BsdfFractionLoss>> losses;
-    std::vector<std::pair<uint64_t, uint64_t>> sums;  // (flat index, value)
+    struct Sum {
+      uint32_t leaf;
+      uint64_t cell;  // node * 4 + quadrant in the leaf's building tree
+      uint64_t value;
+    };
+    std::vector<Sum> sums;
   };
   static bool parse_records(const SpatialTree& t, std::string_view bytes, Records& out, std::string& error);
   static bool add_records(SpatialTree& t, std::string_view bytes, std::string& error);
@@ -247,22 +252,19 @@ bool TreeIo::parse_records(const SpatialTree& t, std::string_view bytes, Records
       if (ok) read_entry(at);
     }
   };
-  std::vector<std::pair<uint32_t, uint64_t>>& samples = out.samples;
-  read_list(t.leaves_.size(), [&](uint64_t leaf) { samples.emplace_back(uint32_t(leaf), r.varint()); });
-  std::vector<std::pair<uint32_t, BsdfFractionLoss>>& losses = out.losses;
+  read_list(t.leaves_.size(), [&](uint64_t leaf) { out.samples.emplace_back(uint32_t(leaf), r.varint()); });
   read_list(t.leaves_.size(), [&](uint64_t leaf) {
     BsdfFractionLoss l;
     for (int64_t& v : l.loss_) v = r.signed_varint();
     l.records_ = r.varint();
-    losses.emplace_back(uint32_t(leaf), l);
+    out.losses.emplace_back(uint32_t(leaf), l);
   });
-  std::vector<std::pair<uint64_t, uint64_t>>& sums = out.sums;
   read_list(offset.back(), [&](uint64_t at) {
     // Only leaf quadrants hold recorded sums (inner ones are made by build()).
     const size_t leaf = size_t(std::upper_bound(offset.begin(), offset.end(), at) - offset.begin()) - 1;
     const uint64_t cell = at - offset[leaf];
     ok = t.leaves_[leaf].building.nodes_[cell / 4].child[cell % 4] == 0;
-    sums.emplace_back(at, r.varint());
+    out.sums.push_back({uint32_t(leaf), cell, r.varint()});
   });
   if (!ok || !r.ok || r.left() != 0) {
     error = "training records: malformed, or not recorded with this job's guide";
@@ -274,14 +276,10 @@ bool TreeIo::parse_records(const SpatialTree& t, std::string_view bytes, Records
 bool TreeIo::add_records(SpatialTree& t, std::string_view bytes, std::string& error) {
   Records records;
   if (!parse_records(t, bytes, records, error)) return false;  // (the tree unchanged)
-  const std::vector<uint64_t> offset = offsets(t);
   for (auto& [leaf, n] : records.samples) t.leaves_[leaf].samples += n;
   for (auto& [leaf, l] : records.losses) t.leaves_[leaf].fraction_loss.merge(l);
-  for (auto& [at, v] : records.sums) {
-    const size_t leaf = size_t(std::upper_bound(offset.begin(), offset.end(), at) - offset.begin()) - 1;
-    const uint64_t cell = at - offset[leaf];
-    t.leaves_[leaf].building.nodes_[cell / 4].sum[cell % 4] += v;  // (wraps as record()'s atomic add does)
-  }
+  for (const Records::Sum& s : records.sums)  // (wraps as record()'s atomic add does)
+    t.leaves_[s.leaf].building.nodes_[s.cell / 4].sum[s.cell % 4] += s.value;
   return true;
 }
 
