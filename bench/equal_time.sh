@@ -7,12 +7,16 @@
 # the medians over seeds, and the relMSE at the plain render's median time, taking the error above
 # the floor to fall as 1/time (the estimators are unbiased):
 #   equal-time relMSE = floor + (relMSE - floor) * seconds / plain's seconds
+# and, the same way, the time each configuration needs to bring the error above the floor down to
+# 0.05 and 0.01 (against the floor, since kitchenette's and veach-bidir's floors are above 0.01):
+#   time to X = (relMSE - floor) * seconds / X
 # Writes OUT/equal_time.csv (every run) and OUT/equal_time.md (the table), and prints the table.
 #
 # Usage: bench/equal_time.sh [BUILD_DIR] [SPP]      (defaults: build, 128)
 # Environment: ET_SCENES="cornell-box ..." (default all seven)  ET_SEEDS="1 2 3"
 #   ET_CONFIGS="plain adaptive guided guided+adaptive"  ET_THREADS=2  ET_OUT=docs/performance
 #   TESSERA=path/to/tessera (default BUILD_DIR/cli/tessera)
+#   ET_TABLE_ONLY=1: render nothing, make the table again from OUT/equal_time.csv
 # A missing scene or reference is an error (exit 1), never a skip.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -36,9 +40,9 @@ for s in "${scenes[@]}"; do
 done
 mkdir -p "$out"
 csv="$out/equal_time.csv"
-echo "scene,config,seed,spp,seconds,rel_mse,rel_mse_trim,ref_floor" > "$csv"
+[ -n "${ET_TABLE_ONLY:-}" ] && scenes=() || echo "scene,config,seed,spp,seconds,rel_mse,rel_mse_trim,ref_floor" > "$csv"
 
-for s in "${scenes[@]}"; do
+for s in ${scenes[@]+"${scenes[@]}"}; do
   res=$(grep -o 'Resolution [0-9]*×[0-9]*' "$shared/references/$s/README.md" | grep -o '[0-9][0-9]*')
   w=$(echo "$res" | sed -n 1p); h=$(echo "$res" | sed -n 2p)
   extra=()
@@ -71,7 +75,10 @@ runs = {}
 for r in rows:
     runs.setdefault((r["scene"], r["config"]), []).append(r)
 lines = ["| scene | configuration | seconds | relMSE | relMSE, worst 0.1% left out | reference floor | "
-         "relMSE at plain's time | against plain |", "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+         "relMSE at plain's time | against plain | seconds to 0.05 above floor | seconds to 0.01 above floor |",
+         "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+def time_to(rs, floor, target):
+    return "%.3g" % med([(float(r["rel_mse"]) - floor) * float(r["seconds"]) / target for r in rs])
 for scene in dict.fromkeys(r["scene"] for r in rows):
     plain = runs.get((scene, "plain"))
     t_plain = med([float(r["seconds"]) for r in plain]) if plain else None
@@ -86,9 +93,9 @@ for scene in dict.fromkeys(r["scene"] for r in rows):
         if config == "plain":
             e_plain = eq
         ratio = "%.2f" % (eq / e_plain) if eq is not None and e_plain else ""
-        lines.append("| %s | %s | %.2f | %.4g | %.4g | %.2g | %s | %s |" % (
+        lines.append("| %s | %s | %.2f | %.4g | %.4g | %.2g | %s | %s | %s | %s |" % (
             scene, config, t, med([float(r["rel_mse"]) for r in rs]), med([float(r["rel_mse_trim"]) for r in rs]),
-            floor, "%.4g" % eq if eq is not None else "", ratio))
+            floor, "%.4g" % eq if eq is not None else "", ratio, time_to(rs, floor, 0.05), time_to(rs, floor, 0.01)))
 open(sys.argv[2], "w").write("\n".join(lines) + "\n")
 print("\n".join(lines))
 PY
