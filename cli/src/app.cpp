@@ -43,6 +43,9 @@ int main_entry(int argc, char** argv) {
                 "Adaptive sampling: after the first quarter of the samples, each pass spends its samples "
                 "where the estimated error is (--spp stays the total; default off)")
       ->check(CLI::IsMember({"on", "off"}))->capture_default_str();
+  r->add_option("--aovs", render.aovs,
+                "Layers written into each .exr output beside the image: albedo, normal, depth, variance, "
+                "half_a, half_b, comma-separated, or all (docs/denoising.md); the image stays the same bits");
   r->add_option("--width", render.width, "Film width (default: the scene's)")->check(CLI::PositiveNumber);
   r->add_option("--height", render.height, "Film height (default: the scene's)")->check(CLI::PositiveNumber);
   r->add_option("--threads", render.threads, "Render threads (default: all cores)")->check(CLI::NonNegativeNumber);

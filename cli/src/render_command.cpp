@@ -58,8 +58,17 @@ size_t mesh_bytes(const Scene& scene) {
   return bytes;
 }
 
-void write_outputs(const RenderOptions& options, const Scene& scene, const Film& film, uint32_t spp) {
+// The AOV layers asked for, as written into EXR outputs.
+std::vector<ImageLayer> aov_layers(const Film& film, const std::vector<AovLayer>& asked) {
+  std::vector<ImageLayer> layers;
+  for (AovLayer l : asked) layers.push_back({aov_layer_name(l), aov_channel_names(l), film.aov_image(l)});
+  return layers;
+}
+
+void write_outputs(const RenderOptions& options, const Scene& scene, const Film& film, uint32_t spp,
+                   const std::vector<AovLayer>& aovs) {
   Image image = film.to_image();
+  const std::vector<ImageLayer> layers = aov_layers(film, aovs);
   ImageAttributes attributes = {{"tessera_version", TESSERA_VERSION},
                                 {"tessera_scene", options.scene},
                                 {"tessera_spp", std::to_string(spp)},
@@ -75,6 +84,8 @@ void write_outputs(const RenderOptions& options, const Scene& scene, const Film&
         ldr.exposure = scene.film.exposure;
       }
       write_png(out, image, ldr);
+    } else if (ext == ".exr") {
+      write_exr_layers(out, image, layers, attributes);
     } else {
       write_image(out, image, attributes);
     }
@@ -89,6 +100,22 @@ int run_render(const RenderOptions& options) {
     std::string ext = lower_extension(out);
     if (ext != ".exr" && ext != ".pfm" && ext != ".png") {
       std::cerr << "tessera render: output '" << out << "': unknown format (use .exr, .pfm or .png)\n";
+      return 2;
+    }
+  }
+  std::vector<AovLayer> aovs;
+  if (!options.aovs.empty()) {
+    std::string error;
+    auto parsed = parse_aov_layers(options.aovs, &error);
+    if (!parsed) {
+      std::cerr << "tessera render: --aovs: " << error << "\n";
+      return 2;
+    }
+    aovs = *parsed;
+    bool exr = false;
+    for (const auto& out : options.outputs) exr |= lower_extension(out) == ".exr";
+    if (!exr && !options.outputs.empty()) {
+      std::cerr << "tessera render: --aovs: AOV layers are written only into .exr outputs; give one with -o\n";
       return 2;
     }
   }
@@ -129,6 +156,7 @@ int run_render(const RenderOptions& options) {
     settings.guiding = options.guiding.empty() ? scene.integrator.guiding.has_value() : options.guiding == "on";
     if (scene.integrator.guiding) settings.guiding_settings = *scene.integrator.guiding;
     settings.adaptive = options.adaptive == "on";
+    settings.aovs = !aovs.empty();
 
     const std::vector<uint32_t> passes = pass_schedule(uint32_t(settings.spp));
     Progress progress("render", !options.quiet);
@@ -144,7 +172,7 @@ int run_render(const RenderOptions& options) {
         },
         &stats);
     progress.finish();
-    write_outputs(options, scene, film, stats.spp_done);
+    write_outputs(options, scene, film, stats.spp_done, aovs);
 
     const auto& c = stats.counters;
     BvhStats bvh = scene.accel().stats();

@@ -99,14 +99,20 @@ Image read_exr(const std::string& path, ImageAttributes* attributes) {
   }
 }
 
-void write_exr(const std::string& path, const Image& image_in, const ImageAttributes& attributes) {
-  if (image_in.empty()) fail(path, "cannot write an empty image");
-  const Image image = image_in.srgb_encoded() ? image_in.linearized() : image_in;
-  Imf::Header header(image.width(), image.height());
+namespace {
+
+// One channel to write: its full name and where its values are (every `stride` floats).
+struct OutChannel {
+  std::string name;
+  const float* first;
+  size_t stride;
+};
+
+void write_channels(const std::string& path, int width, int height, const std::vector<OutChannel>& channels,
+                    const ImageAttributes& attributes) {
+  Imf::Header header(width, height);
   header.compression() = Imf::ZIP_COMPRESSION;
-  static const char* kNames[3][4] = {{"Y"}, {"R", "G", "B"}, {"R", "G", "B", "A"}};
-  const char* const* names = image.channels() == 1 ? kNames[0] : (image.channels() == 3 ? kNames[1] : kNames[2]);
-  for (int c = 0; c < image.channels(); ++c) header.channels().insert(names[c], Imf::Channel(Imf::FLOAT));
+  for (const auto& c : channels) header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
   for (const auto& [key, value] : attributes) {
     if (key.empty() || reserved_attribute_names().count(key))
       fail(path, "EXR attribute name '" + key + "' is empty or reserved");
@@ -117,15 +123,76 @@ void write_exr(const std::string& path, const Image& image_in, const ImageAttrib
   try {
     Imf::OutputFile file(path.c_str(), header);
     Imf::FrameBuffer fb;
-    size_t xstride = sizeof(float) * size_t(image.channels()), ystride = xstride * size_t(image.width());
-    // OpenEXR's Slice takes a non-const pointer even for output.
-    char* base = reinterpret_cast<char*>(const_cast<float*>(image.data()));
-    for (int c = 0; c < image.channels(); ++c)
-      fb.insert(names[c], Imf::Slice(Imf::FLOAT, base + sizeof(float) * size_t(c), xstride, ystride));
+    for (const auto& c : channels) {
+      const size_t xstride = sizeof(float) * c.stride;
+      // OpenEXR's Slice takes a non-const pointer even for output.
+      char* base = reinterpret_cast<char*>(const_cast<float*>(c.first));
+      fb.insert(c.name, Imf::Slice(Imf::FLOAT, base, xstride, xstride * size_t(width)));
+    }
     file.setFrameBuffer(fb);
-    file.writePixels(image.height());
+    file.writePixels(height);
   } catch (const std::exception& e) {
     fail(path, std::string("cannot write EXR: ") + e.what());
+  }
+}
+
+// The channels of `image`, named `prefix` + names[c].
+void add_channels(std::vector<OutChannel>& out, const Image& image, const std::string& prefix,
+                  const std::vector<std::string>& names) {
+  for (int c = 0; c < image.channels(); ++c)
+    out.push_back({prefix + names[size_t(c)], image.data() + c, size_t(image.channels())});
+}
+
+const std::vector<std::string>& beauty_channel_names(int channels) {
+  static const std::vector<std::string> kNames[3] = {{"Y"}, {"R", "G", "B"}, {"R", "G", "B", "A"}};
+  return kNames[channels == 1 ? 0 : (channels == 3 ? 1 : 2)];
+}
+
+}  // namespace
+
+void write_exr(const std::string& path, const Image& image_in, const ImageAttributes& attributes) {
+  write_exr_layers(path, image_in, {}, attributes);
+}
+
+void write_exr_layers(const std::string& path, const Image& beauty_in, const std::vector<ImageLayer>& layers,
+                      const ImageAttributes& attributes) {
+  if (beauty_in.empty()) fail(path, "cannot write an empty image");
+  const Image beauty = beauty_in.srgb_encoded() ? beauty_in.linearized() : beauty_in;
+  std::vector<OutChannel> channels;
+  add_channels(channels, beauty, "", beauty_channel_names(beauty.channels()));
+  for (const auto& layer : layers) {
+    TESSERA_CHECK(layer.image.width() == beauty.width() && layer.image.height() == beauty.height() &&
+                  size_t(layer.image.channels()) == layer.channels.size());
+    add_channels(channels, layer.image, layer.name + ".", layer.channels);
+  }
+  write_channels(path, beauty.width(), beauty.height(), channels, attributes);
+}
+
+Image read_exr_layer(const std::string& path, const std::string& name, const std::vector<std::string>& channels) {
+  image_detail::require_readable_file(path);
+  try {
+    Imf::InputFile file(path.c_str());
+    const Imf::Header& header = file.header();
+    const Imath::Box2i dw = header.dataWindow();
+    const long long w = (long long)dw.max.x - dw.min.x + 1, h = (long long)dw.max.y - dw.min.y + 1;
+    if (w <= 0 || h <= 0 || w > INT_MAX / 4 || h > INT_MAX / 4 || w * h > (1LL << 31))
+      fail(path, "EXR data window is empty or too large");
+    std::string missing;
+    for (const auto& c : channels)
+      if (!header.channels().findChannel(name + "." + c)) missing += (missing.empty() ? "" : ", ") + name + "." + c;
+    if (!missing.empty()) fail(path, "EXR has no layer '" + name + "' (missing channels: " + missing + ")");
+    Image img(int(w), int(h), int(channels.size()));
+    Imf::FrameBuffer fb;
+    const size_t xstride = sizeof(float) * channels.size(), ystride = xstride * size_t(w);
+    for (size_t c = 0; c < channels.size(); ++c)
+      fb.insert(name + "." + channels[c], Imf::Slice::Make(Imf::FLOAT, img.data() + c, dw, xstride, ystride));
+    file.setFrameBuffer(fb);
+    file.readPixels(dw.min.y, dw.max.y);
+    return img;
+  } catch (const SceneError&) {
+    throw;
+  } catch (const std::exception& e) {
+    fail(path, std::string("cannot read EXR: ") + e.what());
   }
 }
 

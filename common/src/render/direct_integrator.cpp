@@ -14,7 +14,7 @@ class DirectIntegrator final : public Integrator {
   explicit DirectIntegrator(const IntegratorSettings& s) : s_(s) {}
 
   Rgb li(const Scene& scene, const Ray& ray, Sampler& sampler, RenderCounters& counters,
-         const PathGuide* /*guide*/) const override {
+         const PathGuide* /*guide*/, SampleFeatures* features) const override {
     Rgb L;
     SurfaceInteraction si;
     if (!scene.intersect(ray, si)) {
@@ -23,6 +23,10 @@ class DirectIntegrator final : public Integrator {
       return L;
     }
     const Vec3 wo_world = -ray.d;
+    if (features) {
+      features->depth_found = true;
+      features->depth = length(si.p - ray.o);
+    }
     if (const Light* area = si.area_light(); area && !s_.hide_emitters) L += area->le(si, wo_world);
 
     if (!reconcile_shading_frame(si, wo_world, s_.strict_normals)) return L;
@@ -60,7 +64,13 @@ class DirectIntegrator final : public Integrator {
       const float u_lobe = sampler.next_1d();
       const Vec2 u_bsdf = sampler.next_2d();
       BsdfSample bs;
-      if (!bsdf->sample(si, wo, u_lobe, u_bsdf, bs)) continue;
+      const bool sampled = bsdf->sample(si, wo, u_lobe, u_bsdf, bs);
+      if (features && j == 0) {  // its first BSDF sample estimates the albedo, as in path (aov.h)
+        features->found = true;
+        features->albedo = sampled ? bs.weight : Rgb();
+        features->normal = si.shading.n;
+      }
+      if (!sampled) continue;
       const Vec3 wi_world = si.to_world(bs.wi);
       if (!consistent_side(si, wi_world, bs.wi)) continue;
       Ray next = spawn_ray(si, wi_world);

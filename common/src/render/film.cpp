@@ -3,6 +3,7 @@
 #include "tessera/core/check.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace tessera {
 
@@ -20,39 +21,68 @@ RenderCounters& RenderCounters::operator+=(const RenderCounters& o) {
   return *this;
 }
 
-FilmTile::FilmTile(const TileRect& rect) { reset(rect); }
+FilmTile::FilmTile(const TileRect& rect, bool aovs) { reset(rect, aovs); }
 
-void FilmTile::reset(const TileRect& rect) {
+void FilmTile::reset(const TileRect& rect, bool aovs) {
   TESSERA_CHECK(!rect.empty());
   rect_ = rect;
   pixels_.assign(size_t(rect.area()), PixelSums{});
+  if (aovs) aovs_.assign(size_t(rect.area()), AovSums{});
+  else aovs_.clear();
   counters = {};
 }
 
-Film::Film(const TileRect& window, int full_width, int full_height)
+namespace {
+
+// A feature that is not finite (a degenerate BSDF sample) counts as 0, as a beauty sample does.
+double finite_or_zero(float v) { return std::isfinite(v) ? double(v) : 0.0; }
+
+}  // namespace
+
+void FilmTile::add_sample(Vec2i pixel, Rgb value, uint32_t index_in_pixel, const SampleFeatures& f) {
+  add_sample(pixel, value);
+  TESSERA_DCHECK(!aovs_.empty());
+  AovSums& a = aovs_[index(pixel)];
+  for (int c = 0; c < 3; ++c) {
+    a.albedo[c] += finite_or_zero(f.albedo[c]);
+    a.normal[c] += finite_or_zero(f.normal[c]);
+  }
+  a.depth += finite_or_zero(f.depth);
+  if (index_in_pixel % 2 != 0) return;
+  ++a.half_count;
+  if (value.is_finite())
+    for (int c = 0; c < 3; ++c) a.half_sum[c] += double(value[c]);
+}
+
+Film::Film(const TileRect& window, int full_width, int full_height, bool aovs)
     : window_(window), full_width_(full_width), full_height_(full_height) {
   TESSERA_CHECK(!window.empty());
   pixels_.assign(size_t(window.area()), PixelSums{});
+  if (aovs) aovs_.assign(size_t(window.area()), AovSums{});
 }
 
-Film::Film(const FilmSettings& s) : Film(film_window(s), s.width, s.height) {}
+Film::Film(const FilmSettings& s, bool aovs) : Film(film_window(s), s.width, s.height, aovs) {}
 
 void Film::add_tile(const FilmTile& tile) {
   const TileRect& r = tile.rect();
   TESSERA_CHECK(window_.contains(r));
+  TESSERA_CHECK(tile.has_aovs() == has_aovs());
   const auto& src = tile.pixels();
   for (int y = r.y0; y < r.y1; ++y) {
     for (int x = r.x0; x < r.x1; ++x) {
-      const PixelSums& s = src[size_t(y - r.y0) * size_t(r.width()) + size_t(x - r.x0)];
+      const size_t i = size_t(y - r.y0) * size_t(r.width()) + size_t(x - r.x0);
+      const PixelSums& s = src[i];
       PixelSums& d = pixels_[index({x, y})];
       for (int c = 0; c < 3; ++c) {
         d.sum[c] += s.sum[c];
         d.sum_sq[c] += s.sum_sq[c];
       }
       d.count += s.count;
+      if (has_aovs()) add_aov_sums(aovs_[index({x, y})], tile.aovs()[i]);
     }
   }
 }
+
 
 Rgb Film::mean(Vec2i p) const {
   const PixelSums& s = pixel(p);
@@ -96,6 +126,33 @@ void Film::to_image_rows(Image& img, int row_begin, int row_end) const {
   TESSERA_CHECK(img.width() == width() && img.height() == height() && row_begin >= 0 && row_end <= height());
   for (int y = window_.y0 + row_begin; y < window_.y0 + row_end; ++y)
     for (int x = window_.x0; x < window_.x1; ++x) img.set_rgb(x - window_.x0, y - window_.y0, mean({x, y}));
+}
+
+Image Film::aov_image(AovLayer layer) const {
+  if (layer == AovLayer::Variance) return variance_image();
+  TESSERA_CHECK(has_aovs());
+  Image img(width(), height(), layer == AovLayer::Depth ? 1 : 3);
+  for (int y = window_.y0; y < window_.y1; ++y)
+    for (int x = window_.x0; x < window_.x1; ++x) {
+      const PixelSums& p = pixel({x, y});
+      const AovSums& a = aov({x, y});
+      const double n = double(p.count), inv = p.count > 0 ? 1.0 / n : 0.0;
+      double v[3] = {0, 0, 0};
+      for (int c = 0; c < 3; ++c) {
+        switch (layer) {
+          case AovLayer::Albedo: v[c] = a.albedo[c] * inv; break;
+          case AovLayer::Normal: v[c] = a.normal[c] * inv; break;
+          case AovLayer::Depth: v[c] = a.depth * inv; break;
+          case AovLayer::HalfA: v[c] = a.half_count > 0 ? a.half_sum[c] / double(a.half_count) : 0.0; break;
+          default: {
+            const uint64_t nb = p.count - a.half_count;
+            v[c] = nb > 0 ? (p.sum[c] - a.half_sum[c]) / double(nb) : 0.0;
+          }
+        }
+      }
+      for (int c = 0; c < img.channels(); ++c) img.at(x - window_.x0, y - window_.y0, c) = float(v[c]);
+    }
+  return img;
 }
 
 Image Film::variance_image() const {

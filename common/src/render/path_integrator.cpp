@@ -66,6 +66,8 @@ struct PathState {
   const Medium* medium = nullptr;
   const PathGuide* guide = nullptr;  // path guiding, if this pass guides or trains
   GuideRecords* records = nullptr;   // where a training pass keeps the path's vertices
+  SampleFeatures* features = nullptr;  // AOVs, when asked for (aov.h)
+  Vec3 camera_o;                       // the camera ray's origin, for the depth AOV
 };
 
 // What a segment through a medium did to the path.
@@ -76,13 +78,15 @@ class PathIntegrator final : public Integrator {
   PathIntegrator(const IntegratorSettings& s, bool volumetric) : s_(s), volumetric_(volumetric) {}
 
   Rgb li(const Scene& scene, const Ray& camera_ray, Sampler& sampler, RenderCounters& counters,
-         const PathGuide* guide) const override {
+         const PathGuide* guide, SampleFeatures* features) const override {
     if (s_.max_depth == 0) return {};
     const bool media = volumetric_ && scene.has_media();
     PathState path;
     path.medium = media ? scene.camera_medium : nullptr;
     path.ray = camera_ray;
     path.guide = guide;
+    path.features = features;
+    path.camera_o = camera_ray.o;
     GuideRecords records;
     if (guide && guide->train) path.records = &records;
     SurfaceInteraction si;
@@ -130,6 +134,10 @@ class PathIntegrator final : public Integrator {
     Vec3 wi;
     float pdf = 0.f;
     const float weight = v.phase->sample(v.wo, u.u_dir, wi, pdf);
+    if (path.features && !path.features->found) {
+      path.features->found = true;
+      path.features->albedo = path.throughput;
+    }
     if (!(weight > 0.f) || !(pdf > 0.f)) return MediumEvent::Ended;
     path.throughput *= weight;
     path.prev_pdf = pdf;
@@ -169,6 +177,10 @@ class PathIntegrator final : public Integrator {
       return true;
     }
     path.null_crossings = 0;
+    if (path.features && !path.features->depth_found) {
+      path.features->depth_found = true;
+      path.features->depth = length(si.p - path.camera_o);
+    }
     const Vec3 wo_world = -path.ray.d;
     if (const Light* area = si.area_light(); area && visible_emitters(path)) add_emission(scene, path, si, *area);
     if (s_.max_depth >= 0 && path.depth + 1 >= s_.max_depth) return false;
@@ -196,9 +208,11 @@ class PathIntegrator final : public Integrator {
     }
     BsdfSample bs;
     MixturePdfs mixture;
-    if (guide ? !sample_guided(*bsdf, si, wo, *guide, fraction, u.u_lobe, u.u_dir, bs, &mixture)
-              : !bsdf->sample(si, wo, u.u_lobe, u.u_dir, bs))
-      return false;
+    const bool sampled = guide ? sample_guided(*bsdf, si, wo, *guide, fraction, u.u_lobe, u.u_dir, bs, &mixture)
+                               : bsdf->sample(si, wo, u.u_lobe, u.u_dir, bs);
+    if (path.features && !path.features->found && !bsdf->is_delta())
+      take_features(*path.features, si, path.throughput, sampled ? bs.weight : Rgb());
+    if (!sampled) return false;
     const Vec3 wi_world = si.to_world(bs.wi);
     if (!consistent_side(si, wi_world, bs.wi)) return false;
     path.throughput *= bs.weight;
@@ -215,6 +229,14 @@ class PathIntegrator final : public Integrator {
     path.ray = spawn_ray(si, wi_world);
     ++counters.bounce_rays;
     return true;
+  }
+
+  // The first vertex that is not purely specular: the albedo is the chain's throughput times this
+  // sample's eval·cos/pdf, an estimate of the BSDF's directional albedo (aov.h).
+  static void take_features(SampleFeatures& f, const SurfaceInteraction& si, Rgb throughput, Rgb weight) {
+    f.found = true;
+    f.albedo = throughput * weight;
+    f.normal = si.shading.n;
   }
 
   // An emitter hit by the path, MIS-weighted against the previous vertex's light sampling.

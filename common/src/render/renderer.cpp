@@ -48,9 +48,9 @@ namespace {
 
 void render_tile_with(const Scene& scene, const Integrator& integrator, const Filter* filter,
                       const TileRect& rect, const PassSamples& samples, uint32_t seed,
-                      const PathGuide* guide, FilmTile& tile) {
+                      const PathGuide* guide, bool aovs, FilmTile& tile) {
   TESSERA_CHECK(scene.camera != nullptr);
-  tile.reset(rect);
+  tile.reset(rect, aovs);
   Sampler sampler(scene.sampler.type, seed);
   const bool timed = scene.has_shutter_interval();
   const float open = scene.shutter_open, shutter = scene.shutter_close - scene.shutter_open;
@@ -70,8 +70,13 @@ void render_tile_with(const Scene& scene, const Integrator& integrator, const Fi
         const float time = timed ? open + shutter * sampler.sample_1d_at(Sampler::kTimeDimension) : open;
         Ray ray = scene.camera->generate_ray_at(raster, u_lens, time);
         ++tile.counters.camera_rays;
-        Rgb L = integrator.li(scene, ray, sampler, tile.counters, guide);
-        tile.add_sample({x, y}, L);
+        if (tile.has_aovs()) {
+          SampleFeatures features;
+          const Rgb L = integrator.li(scene, ray, sampler, tile.counters, guide, &features);
+          tile.add_sample({x, y}, L, s, features);
+        } else {
+          tile.add_sample({x, y}, integrator.li(scene, ray, sampler, tile.counters, guide, nullptr));
+        }
       }
     }
   }
@@ -85,17 +90,17 @@ void render_tile(const Scene& scene, const TileRect& rect, uint32_t sample_begin
 }
 
 void render_tile(const Scene& scene, const TileRect& rect, const PassSamples& samples, uint32_t seed, FilmTile& tile,
-                 const PathGuide* guide) {
+                 const PathGuide* guide, bool aovs) {
   TESSERA_CHECK(samples.rect.contains(rect));
   auto integrator = make_integrator(scene.integrator);
-  render_tile_with(scene, *integrator, scene.film.filter.get(), rect, samples, seed, guide, tile);
+  render_tile_with(scene, *integrator, scene.film.filter.get(), rect, samples, seed, guide, aovs, tile);
 }
 
 Film render(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress,
             RenderStats* stats) {
   auto start = std::chrono::steady_clock::now();
   TESSERA_CHECK(settings.spp >= 0 && settings.tile_size > 0);
-  Film film(scene.film);
+  Film film(scene.film, settings.aovs);
   const std::vector<TileRect> tiles = make_tiles(film.window(), settings.tile_size);
   const std::vector<uint32_t> passes = pass_schedule(uint32_t(settings.spp));
   auto integrator = make_integrator(scene.integrator);
@@ -130,7 +135,7 @@ Film render(const Scene& scene, const RenderSettings& settings, const ProgressCa
       tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
         FilmTile tile;
         for (size_t i = r.begin(); i != r.end(); ++i) {
-          render_tile_with(scene, *integrator, filter, tiles[i], samples, settings.seed, pass_guide, tile);
+          render_tile_with(scene, *integrator, filter, tiles[i], samples, settings.seed, pass_guide, settings.aovs, tile);
           if (!(guide.train && tree && settings.guiding_settings.discard_training)) film.add_tile(tile);
           std::lock_guard<std::mutex> lock(mutex);
           counters += tile.counters;

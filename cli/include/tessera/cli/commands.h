@@ -24,6 +24,7 @@ struct RenderOptions {
   double target_error = 0;                 // > 0: stop at this estimated relMSE (spp is the budget)
   std::string guiding;                     // path guiding: "on", "off"; empty: as the scene says
   std::string adaptive = "off";            // adaptive sampling: "on" or "off"
+  std::string aovs;                        // AOV layers for EXR outputs (render/aov.h); empty: none
   bool allow_unsupported = false;
   bool quiet = false;
 };

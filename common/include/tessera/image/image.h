@@ -94,6 +94,20 @@ Image read_exr(const std::string& path, ImageAttributes* attributes = nullptr);
 /// float32, ZIP compression, channels Y / RGB / RGBA by channel count.
 void write_exr(const std::string& path, const Image& image, const ImageAttributes& attributes = {});
 
+/// A named layer of a multi-layer EXR: channels "<name>.<channel>" (albedo.R, normal.X, depth.Z),
+/// the layer convention OpenEXR documents and OpenImageIO, Mitsuba 3 and Blender follow.
+/// `image` has one channel per name in `channels`.
+struct ImageLayer {
+  std::string name;
+  std::vector<std::string> channels;
+  Image image;
+};
+/// float32, ZIP: `beauty` as R,G,B (as write_exr) and every layer, all of one size.
+void write_exr_layers(const std::string& path, const Image& beauty, const std::vector<ImageLayer>& layers,
+                      const ImageAttributes& attributes = {});
+/// Layer `name`'s `channels`, in that order; the error names the file and every missing channel.
+Image read_exr_layer(const std::string& path, const std::string& name, const std::vector<std::string>& channels);
+
 /// PF (RGB) or Pf (grey); either byte order; values multiplied by |scale| when it is not 1.
 Image read_pfm(const std::string& path);
 /// Little-endian (scale -1), rows bottom to top as the format says; alpha dropped.

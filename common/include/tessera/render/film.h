@@ -11,6 +11,7 @@
 #include "tessera/core/rgb.h"
 #include "tessera/core/vec.h"
 #include "tessera/image/image.h"
+#include "tessera/render/aov.h"
 #include "tessera/render/camera.h"
 
 #include <cstdint>
@@ -56,9 +57,10 @@ struct RenderCounters {
 class FilmTile {
  public:
   FilmTile() = default;
-  explicit FilmTile(const TileRect& rect);
-  /// Zeroes the sums and counters and moves the tile to `rect` (reuses storage).
-  void reset(const TileRect& rect);
+  explicit FilmTile(const TileRect& rect, bool aovs = false);
+  /// Zeroes the sums and counters and moves the tile to `rect` (reuses storage); with `aovs` it
+  /// also keeps the AOV sums (aov.h), which add_sample with features fills.
+  void reset(const TileRect& rect, bool aovs = false);
 
   const TileRect& rect() const { return rect_; }
   /// Adds one sample of `pixel` (inside rect()). A non-finite value adds 0 and is counted.
@@ -76,10 +78,18 @@ class FilmTile {
       px.sum_sq[c] += v * v;
     }
   }
+  /// Adds sample `index` of `pixel` with its features (a tile reset with AOVs): as above, and the
+  /// features' sums; an even index also goes to half A.
+  void add_sample(Vec2i pixel, Rgb value, uint32_t index, const SampleFeatures& features);
+
   const PixelSums& pixel(Vec2i p) const { return pixels_[index(p)]; }
   const std::vector<PixelSums>& pixels() const { return pixels_; }
   /// For decoders of remote tile results (farm/tile_result.h); size stays rect().area().
   std::vector<PixelSums>& mutable_pixels() { return pixels_; }
+  bool has_aovs() const { return !aovs_.empty(); }
+  /// Empty without AOVs, else one per pixel.
+  const std::vector<AovSums>& aovs() const { return aovs_; }
+  std::vector<AovSums>& mutable_aovs() { return aovs_; }
 
   RenderCounters counters;
 
@@ -87,6 +97,7 @@ class FilmTile {
   size_t index(Vec2i p) const { return size_t(p.y - rect_.y0) * size_t(rect_.width()) + size_t(p.x - rect_.x0); }
   TileRect rect_;
   std::vector<PixelSums> pixels_;
+  std::vector<AovSums> aovs_;
 };
 
 class Film {
@@ -94,8 +105,9 @@ class Film {
   Film() = default;
   /// A film for the pixels of `window` (full-film coordinates); `full_width/height` are the
   /// film's complete size, kept for writers that need the crop offset.
-  Film(const TileRect& window, int full_width, int full_height);
-  explicit Film(const FilmSettings& settings);
+  /// With `aovs` the film also keeps the AOV sums, and takes only tiles that have them.
+  Film(const TileRect& window, int full_width, int full_height, bool aovs = false);
+  explicit Film(const FilmSettings& settings, bool aovs = false);
 
   const TileRect& window() const { return window_; }
   int width() const { return window_.width(); }
@@ -124,6 +136,13 @@ class Film {
   /// Per-pixel variance of the mean (sample variance / count), 3 channels: a noise estimate.
   Image variance_image() const;
 
+  bool has_aovs() const { return !aovs_.empty(); }
+  /// An AOV layer over window() (aov.h): the mean of the pixel's features, the variance image, or
+  /// the mean of half A's or half B's samples (0 for a half without samples). Requires has_aovs()
+  /// except for Variance.
+  Image aov_image(AovLayer layer) const;
+  const AovSums& aov(Vec2i p) const { return aovs_[index(p)]; }
+
   const RenderCounters& counters() const { return counters_; }
 
  private:
@@ -131,6 +150,7 @@ class Film {
   TileRect window_;
   int full_width_ = 0, full_height_ = 0;
   std::vector<PixelSums> pixels_;
+  std::vector<AovSums> aovs_;
   RenderCounters counters_;
 };
 

@@ -29,6 +29,7 @@
 
 #include "tessera/core/ray.h"
 #include "tessera/core/rgb.h"
+#include "tessera/render/aov.h"
 #include "tessera/render/film.h"
 #include "tessera/render/path_guide.h"
 #include "tessera/render/sampler.h"
@@ -44,9 +45,10 @@ class Integrator {
   virtual ~Integrator() = default;
   /// Radiance arriving at the camera along `ray`. Adds the rays it traces (bounce and shadow rays,
   /// not the camera ray itself) to `counters`. `guide`: path guiding for this pass (path_guide.h),
-  /// or null; integrators that do not guide ignore it.
+  /// or null; integrators that do not guide ignore it. `features`, if given (zeroed by the
+  /// caller), receives the sample's AOV features (aov.h; `direct` takes them at the first hit).
   virtual Rgb li(const Scene& scene, const Ray& ray, Sampler& sampler, RenderCounters& counters,
-                 const PathGuide* guide) const = 0;
+                 const PathGuide* guide, SampleFeatures* features) const = 0;
 };
 
 std::unique_ptr<Integrator> make_path_integrator(const IntegratorSettings& settings);

@@ -40,6 +40,8 @@ struct RenderSettings {
   /// estimate says the error is. spp stays the total; a pixel's samples keep consecutive indices.
   bool adaptive = false;
   AdaptiveSettings adaptive_settings;
+  /// Keep the AOV sums (aov.h) in the film; the beauty image is the same bits either way.
+  bool aovs = false;
 };
 
 struct RenderStats {
@@ -75,9 +77,10 @@ void render_tile(const Scene& scene, const TileRect& rect, uint32_t sample_begin
                  uint32_t seed, FilmTile& tile);
 
 /// Renders, for every pixel of `rect`, the samples `samples` gives it (samples.rect contains rect),
-/// guided by `guide` when it is given (a farm worker's unit of a guided job).
+/// guided by `guide` when it is given (a farm worker's unit of a guided job), with the AOV sums
+/// when `aovs` is set.
 void render_tile(const Scene& scene, const TileRect& rect, const PassSamples& samples, uint32_t seed, FilmTile& tile,
-                 const PathGuide* guide = nullptr);
+                 const PathGuide* guide = nullptr, bool aovs = false);
 
 /// Renders the scene's crop window with settings.spp samples per pixel.
 Film render(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress = {},
