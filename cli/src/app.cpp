@@ -46,6 +46,12 @@ int main_entry(int argc, char** argv) {
   r->add_option("--aovs", render.aovs,
                 "Layers written into each .exr output beside the image: albedo, normal, depth, variance, "
                 "half_a, half_b, comma-separated, or all (docs/denoising.md); the image stays the same bits");
+  r->add_flag("--denoise", render.denoise,
+              "Denoise: each -o FILE.ext gets the denoised image and FILE.noisy.ext the raw one; EXR outputs "
+              "carry the AOV layers (all the denoiser's unless --aovs says), so tessera denoise FILE.noisy.exr "
+              "gives the same bits");
+  r->add_option("--denoise-mode", render.denoise_mode, "full, or preview (faster, less thorough)")
+      ->check(CLI::IsMember({"full", "preview"}))->capture_default_str();
   r->add_option("--width", render.width, "Film width (default: the scene's)")->check(CLI::PositiveNumber);
   r->add_option("--height", render.height, "Film height (default: the scene's)")->check(CLI::PositiveNumber);
   r->add_option("--threads", render.threads, "Render threads (default: all cores)")->check(CLI::NonNegativeNumber);
@@ -97,6 +103,17 @@ int main_entry(int argc, char** argv) {
   bc->add_option("--threads", conv.threads, "Render threads (default: all cores)")->check(CLI::NonNegativeNumber);
   bc->add_option("--seed", conv.seed, "Seed of the first budget (budget i uses seed + i)");
   bc->add_flag("--allow-unsupported", conv.allow_unsupported, "Substitute documented fallbacks for unsupported plugins");
+
+  DenoiseOptions dn;
+  auto* dsub = app.add_subcommand("denoise", "Denoise an EXR rendered with --aovs all (docs/denoising.md)");
+  dsub->add_option("input", dn.input, "EXR with the AOV layers albedo, normal, depth, variance, half_a, half_b")
+      ->required()->check(CLI::ExistingFile);
+  dsub->add_option("-o,--output", dn.outputs, "Output image(s): .exr (with the input's AOV layers), .pfm or .png")
+      ->required();
+  dsub->add_option("--mode", dn.mode, "full, or preview (faster, less thorough)")
+      ->check(CLI::IsMember({"full", "preview"}))->capture_default_str();
+  dsub->add_option("--threads", dn.threads, "Threads (default: all cores; the result is the same)")
+      ->check(CLI::NonNegativeNumber);
 
   CompareOptions compare;
   auto* cmp = app.add_subcommand("compare", "Error of an image against a reference (relMSE, means, z-scores)");
@@ -174,6 +191,7 @@ int main_entry(int argc, char** argv) {
   if (br->parsed()) return run_bench_rays(rays);
   if (bc->parsed()) return run_bench_convergence(conv);
   if (cmp->parsed()) return run_compare(compare);
+  if (dsub->parsed()) return run_denoise(dn);
   return 2;
 }
 

@@ -1,6 +1,7 @@
 // `tessera render`: parse -> load (meshes, images, BVH) -> render -> write, with timings.
 #include "tessera/cli/commands.h"
 #include "tessera/cli/progress.h"
+#include "tessera/denoise/denoiser.h"
 #include "tessera/image/image.h"
 #include "tessera/render/renderer.h"
 #include "tessera/render/shape.h"
@@ -58,38 +59,59 @@ size_t mesh_bytes(const Scene& scene) {
   return bytes;
 }
 
-// The AOV layers asked for, as written into EXR outputs.
-std::vector<ImageLayer> aov_layers(const Film& film, const std::vector<AovLayer>& asked) {
-  std::vector<ImageLayer> layers;
-  for (AovLayer l : asked) layers.push_back({aov_layer_name(l), aov_channel_names(l), film.aov_image(l)});
-  return layers;
+// FILE.ext -> FILE.noisy.ext: where --denoise writes the raw image.
+std::string noisy_path(const std::string& path) {
+  std::filesystem::path p(path);
+  return (p.parent_path() / (p.stem().string() + ".noisy" + p.extension().string())).string();
 }
 
+void write_output(const std::string& out, const Scene& scene, const Image& image, const std::vector<ImageLayer>& layers,
+                  const ImageAttributes& attributes) {
+  auto parent = std::filesystem::path(out).parent_path();
+  if (!parent.empty()) std::filesystem::create_directories(parent);
+  const std::string ext = lower_extension(out);
+  if (ext == ".png") {
+    LdrSettings ldr;
+    if (scene.film.ldr) {
+      ldr.gamma = scene.film.gamma;
+      ldr.exposure = scene.film.exposure;
+    }
+    write_png(out, image, ldr);
+  } else if (ext == ".exr") {
+    write_exr_layers(out, image, layers, attributes);
+  } else {
+    write_image(out, image, attributes);
+  }
+  std::cerr << "wrote " << out << "\n";
+}
+
+// Each output gets the image; with --denoise the denoised one, and FILE.noisy.ext the raw one. The
+// denoiser reads the float32 layers the EXR outputs hold, so `tessera denoise FILE.noisy.exr`
+// gives the same bits.
 void write_outputs(const RenderOptions& options, const Scene& scene, const Film& film, uint32_t spp,
                    const std::vector<AovLayer>& aovs) {
-  Image image = film.to_image();
-  const std::vector<ImageLayer> layers = aov_layers(film, aovs);
-  ImageAttributes attributes = {{"tessera_version", TESSERA_VERSION},
-                                {"tessera_scene", options.scene},
-                                {"tessera_spp", std::to_string(spp)},
-                                {"tessera_seed", std::to_string(options.seed)}};
+  const Image raw = film.to_image();
+  const std::vector<ImageLayer> layers = film.aov_layers(aovs);
+  const ImageAttributes attributes = {{"tessera_version", TESSERA_VERSION},
+                                      {"tessera_scene", options.scene},
+                                      {"tessera_spp", std::to_string(spp)},
+                                      {"tessera_seed", std::to_string(options.seed)}};
+  Image denoised;
+  if (options.denoise) {
+    DenoiseSettings settings;
+    settings.mode = options.denoise_mode == "preview" ? DenoiseMode::Preview : DenoiseMode::Full;
+    settings.threads = options.threads;
+    const auto start = Clock::now();
+    denoised = denoise(make_denoise_input(raw, film.aov_layers(denoise_layers())), settings);
+    std::fprintf(stderr, "denoise (%s): %.3f s\n", options.denoise_mode.c_str(), seconds_since(start));
+  }
   for (const auto& out : output_paths(options, scene)) {
-    std::string ext = lower_extension(out);
-    auto parent = std::filesystem::path(out).parent_path();
-    if (!parent.empty()) std::filesystem::create_directories(parent);
-    if (ext == ".png") {
-      LdrSettings ldr;
-      if (scene.film.ldr) {
-        ldr.gamma = scene.film.gamma;
-        ldr.exposure = scene.film.exposure;
-      }
-      write_png(out, image, ldr);
-    } else if (ext == ".exr") {
-      write_exr_layers(out, image, layers, attributes);
+    if (options.denoise) {
+      write_output(out, scene, denoised, layers, attributes);
+      write_output(noisy_path(out), scene, raw, layers, attributes);
     } else {
-      write_image(out, image, attributes);
+      write_output(out, scene, raw, layers, attributes);
     }
-    std::cerr << "wrote " << out << "\n";
   }
 }
 
@@ -104,6 +126,7 @@ int run_render(const RenderOptions& options) {
     }
   }
   std::vector<AovLayer> aovs;
+  if (options.denoise && options.aovs.empty()) aovs = denoise_layers();
   if (!options.aovs.empty()) {
     std::string error;
     auto parsed = parse_aov_layers(options.aovs, &error);
@@ -156,7 +179,7 @@ int run_render(const RenderOptions& options) {
     settings.guiding = options.guiding.empty() ? scene.integrator.guiding.has_value() : options.guiding == "on";
     if (scene.integrator.guiding) settings.guiding_settings = *scene.integrator.guiding;
     settings.adaptive = options.adaptive == "on";
-    settings.aovs = !aovs.empty();
+    settings.aovs = !aovs.empty() || options.denoise;
 
     const std::vector<uint32_t> passes = pass_schedule(uint32_t(settings.spp));
     Progress progress("render", !options.quiet);

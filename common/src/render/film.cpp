@@ -155,6 +155,12 @@ Image Film::aov_image(AovLayer layer) const {
   return img;
 }
 
+std::vector<ImageLayer> Film::aov_layers(const std::vector<AovLayer>& layers) const {
+  std::vector<ImageLayer> out;
+  for (AovLayer l : layers) out.push_back({aov_layer_name(l), aov_channel_names(l), aov_image(l)});
+  return out;
+}
+
 Image Film::variance_image() const {
   Image img(width(), height(), 3);
   for (int y = window_.y0; y < window_.y1; ++y)

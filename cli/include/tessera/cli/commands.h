@@ -25,8 +25,18 @@ struct RenderOptions {
   std::string guiding;                     // path guiding: "on", "off"; empty: as the scene says
   std::string adaptive = "off";            // adaptive sampling: "on" or "off"
   std::string aovs;                        // AOV layers for EXR outputs (render/aov.h); empty: none
+  bool denoise = false;                    // outputs get the denoised image, FILE.noisy.ext the raw one
+  std::string denoise_mode = "full";       // "full" or "preview"
   bool allow_unsupported = false;
   bool quiet = false;
+};
+
+/// `tessera denoise`.
+struct DenoiseOptions {
+  std::string input;                 // an EXR with the AOV layers (render --aovs all)
+  std::vector<std::string> outputs;  // by extension; an .exr keeps the input's layers
+  std::string mode = "full";         // "full" or "preview"
+  int threads = 0;                   // 0: all cores (the result does not depend on it)
 };
 
 struct CompareOptions {
@@ -63,6 +73,7 @@ int run_render(const RenderOptions& options);
 /// `geometry` may also be a single scene .xml: its accelerator is used.
 int run_bench_rays(const BenchRaysOptions& options);
 int run_compare(const CompareOptions& options);
+int run_denoise(const DenoiseOptions& options);
 int run_submit(const SubmitOptions& options);
 int run_jobs(const JobsOptions& options);
 int run_cancel(const JobsOptions& options);

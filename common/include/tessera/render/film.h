@@ -142,6 +142,8 @@ class Film {
   /// except for Variance.
   Image aov_image(AovLayer layer) const;
   const AovSums& aov(Vec2i p) const { return aovs_[index(p)]; }
+  /// The layers, named and with channel names as written into an EXR (aov.h).
+  std::vector<ImageLayer> aov_layers(const std::vector<AovLayer>& layers) const;
 
   const RenderCounters& counters() const { return counters_; }
 

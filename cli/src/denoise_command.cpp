@@ -1,0 +1,57 @@
+// `tessera denoise IN.exr -o OUT.exr`: the denoiser (denoise/denoiser.h) on an EXR written with
+// `--aovs all`. An EXR output keeps the input's AOV layers beside the denoised image.
+#include "tessera/cli/commands.h"
+#include "tessera/denoise/denoiser.h"
+#include "tessera/image/image.h"
+
+#include <chrono>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+
+namespace tessera::cli {
+
+std::vector<ImageLayer> denoise_input_layers(const DenoiseInput& in) {
+  std::vector<ImageLayer> layers;
+  for (AovLayer l : denoise_layers()) {
+    const Image* img = l == AovLayer::Albedo     ? &in.albedo
+                       : l == AovLayer::Normal   ? &in.normal
+                       : l == AovLayer::Depth    ? &in.depth
+                       : l == AovLayer::Variance ? &in.variance
+                       : l == AovLayer::HalfA    ? &in.half_a
+                                                 : &in.half_b;
+    layers.push_back({aov_layer_name(l), aov_channel_names(l), *img});
+  }
+  return layers;
+}
+
+int run_denoise(const DenoiseOptions& options) {
+  try {
+    ImageAttributes attributes;  // kept: the render's scene, seed and spp
+    const DenoiseInput in = read_denoise_input(options.input, &attributes);
+    DenoiseSettings settings;
+    settings.mode = options.mode == "preview" ? DenoiseMode::Preview : DenoiseMode::Full;
+    settings.threads = options.threads;
+    const auto start = std::chrono::steady_clock::now();
+    const Image out = denoise(in, settings);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double megapixels = double(out.width()) * double(out.height()) / 1e6;
+    for (const auto& path : options.outputs) {
+      const auto parent = std::filesystem::path(path).parent_path();
+      if (!parent.empty()) std::filesystem::create_directories(parent);
+      if (std::filesystem::path(path).extension() == ".exr")
+        write_exr_layers(path, out, denoise_input_layers(in), attributes);
+      else
+        write_image(path, out, attributes);
+      std::fprintf(stderr, "wrote %s\n", path.c_str());
+    }
+    std::fprintf(stderr, "denoise (%s): %dx%d in %.3f s (%.2f s per megapixel)\n", options.mode.c_str(), out.width(),
+                 out.height(), seconds, seconds / std::max(megapixels, 1e-9));
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
+  }
+}
+
+}  // namespace tessera::cli
