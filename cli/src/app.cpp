@@ -150,6 +150,9 @@ int main_entry(int argc, char** argv) {
                   "Path guiding, as for render: the same image (default: on for a guided_path integrator, "
                   "else off)")
       ->check(CLI::IsMember({"on", "off"}));
+  sub->add_flag("--denoise", submit.denoise,
+                "Denoise the finished image on the coordinator (job field denoise): each -o FILE.ext gets the "
+                "denoised image and FILE.noisy.ext the raw one (its EXR with the AOV layers), as render --denoise");
   sub->add_option("--adaptive", submit.adaptive, "Adaptive sampling, as for render: the same image (default off)")
       ->check(CLI::IsMember({"on", "off"}))->capture_default_str();
   sub->add_option("--webhook", submit.webhook, "URL the coordinator POSTs the job's status to when it ends");

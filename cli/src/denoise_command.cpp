@@ -25,6 +25,11 @@ std::vector<ImageLayer> denoise_input_layers(const DenoiseInput& in) {
   return layers;
 }
 
+std::string noisy_path(const std::string& path) {
+  std::filesystem::path p(path);
+  return (p.parent_path() / (p.stem().string() + ".noisy" + p.extension().string())).string();
+}
+
 int run_denoise(const DenoiseOptions& options) {
   try {
     ImageAttributes attributes;  // kept: the render's scene, seed and spp

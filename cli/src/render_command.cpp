@@ -59,12 +59,6 @@ size_t mesh_bytes(const Scene& scene) {
   return bytes;
 }
 
-// FILE.ext -> FILE.noisy.ext: where --denoise writes the raw image.
-std::string noisy_path(const std::string& path) {
-  std::filesystem::path p(path);
-  return (p.parent_path() / (p.stem().string() + ".noisy" + p.extension().string())).string();
-}
-
 void write_output(const std::string& out, const Scene& scene, const Image& image, const std::vector<ImageLayer>& layers,
                   const ImageAttributes& attributes) {
   auto parent = std::filesystem::path(out).parent_path();

@@ -47,18 +47,37 @@ std::string extension_of(const std::string& path) {
   return ext.empty() ? ext : ext.substr(1);
 }
 
-bool download_outputs(const client::FarmApi& api, uint64_t id, const std::vector<std::string>& outputs) {
-  for (const std::string& out : outputs) {
-    client::HttpReply r = api.job_image(id, extension_of(out));
-    if (!r.ok()) {
-      std::cerr << "tessera submit: cannot download the image: " << r.describe() << "\n";
-      return false;
-    }
-    if (fs::path(out).has_parent_path()) fs::create_directories(fs::path(out).parent_path());
-    std::ofstream(out, std::ios::binary).write(r.body.data(), std::streamsize(r.body.size()));
-    std::cerr << "wrote " << out << "\n";
+bool download(const client::FarmApi& api, uint64_t id, const std::string& out, bool denoised) {
+  client::HttpReply r = api.job_image(id, extension_of(out), denoised);
+  if (!r.ok()) {
+    std::cerr << "tessera submit: cannot download the " << (denoised ? "denoised " : "") << "image: " << r.describe()
+              << "\n";
+    return false;
   }
+  if (fs::path(out).has_parent_path()) fs::create_directories(fs::path(out).parent_path());
+  std::ofstream(out, std::ios::binary).write(r.body.data(), std::streamsize(r.body.size()));
+  std::cerr << "wrote " << out << "\n";
   return true;
+}
+
+// Each output; for a denoised job the denoised image, and FILE.noisy.ext the raw one (as
+// `tessera render --denoise` writes them). A failed denoise leaves only the raw one, and fails.
+bool download_outputs(const client::FarmApi& api, uint64_t id, const std::vector<std::string>& outputs,
+                      const json& status) {
+  const bool denoised = !status.value("denoise_state", json()).is_null();
+  if (denoised && status.value("denoise_state", json()) != "done")
+    std::cerr << "tessera submit: job " << id << " was not denoised: " << status.value("denoise_error", json()).dump()
+              << "\n";
+  bool ok = true;
+  for (const std::string& out : outputs) {
+    if (!denoised) {
+      ok = download(api, id, out, false) && ok;
+      continue;
+    }
+    ok = download(api, id, noisy_path(out), false) && ok;
+    ok = status.value("denoise_state", json()) == "done" && download(api, id, out, true) && ok;
+  }
+  return ok;
 }
 
 // Polls until the job ends; returns its final status (null when the server stays unreachable).
@@ -111,7 +130,7 @@ int finish_job(const client::FarmApi& api, uint64_t id, const std::vector<std::s
     std::cerr << ", stopped at " << final_status.value("spp_done", 0) << " spp (estimated relMSE "
               << final_status.value("noise_estimate", 0.0) << ")";
   std::cerr << "\n";
-  return download_outputs(api, id, outputs) ? 0 : 1;
+  return download_outputs(api, id, outputs, final_status) ? 0 : 1;
 }
 
 }  // namespace
@@ -148,6 +167,7 @@ int run_submit(const SubmitOptions& o) {
   settings.light_selection = o.light_selection;
   settings.target_error = o.target_error;
   settings.adaptive = o.adaptive == "on";
+  settings.denoise = o.denoise;
   if (!o.guiding.empty()) settings.guiding = o.guiding == "on";
   settings.webhook = o.webhook;
 

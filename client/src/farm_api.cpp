@@ -47,8 +47,8 @@ HttpReply FarmApi::submit_job(const json& settings, const std::string& bundle, d
 }
 HttpReply FarmApi::jobs(double timeout) const { return http_.get(kApi + "/jobs", timeout); }
 HttpReply FarmApi::job(uint64_t id, double timeout) const { return http_.get(job_path(id), timeout); }
-HttpReply FarmApi::job_image(uint64_t id, const std::string& format, double timeout) const {
-  return http_.get(job_path(id) + "/image?format=" + format, timeout);
+HttpReply FarmApi::job_image(uint64_t id, const std::string& format, bool denoised, double timeout) const {
+  return http_.get(job_path(id) + "/image?format=" + format + (denoised ? "&denoised=1" : ""), timeout);
 }
 HttpReply FarmApi::cancel_job(uint64_t id, double timeout) const { return http_.del(job_path(id), json::object(), timeout); }
 HttpReply FarmApi::set_priority(uint64_t id, int priority, double timeout) const {

@@ -90,7 +90,9 @@ TileResult render_lease(const Scene& scene, const Lease& lease, const SpatialTre
   if (lease.guide && lease.guide->train) recorder = make_recorder(*guide);
   std::optional<PathGuide> path_guide;
   if (lease.guide) path_guide = PathGuide{guide, recorder ? &*recorder : nullptr, lease.guide->iteration > 0, lease.guide->train};
-  render_tile(scene, lease.rect, samples, lease.settings.seed, result.film, path_guide ? &*path_guide : nullptr);
+  // A denoised job's units also sum the AOVs the denoiser reads.
+  render_tile(scene, lease.rect, samples, lease.settings.seed, result.film, path_guide ? &*path_guide : nullptr,
+              lease.settings.denoise);
   if (recorder) result.training = write_records(*recorder);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return result;

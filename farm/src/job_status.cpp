@@ -43,6 +43,8 @@ json to_json(const JobStatus& s) {
             {"target_error", s.target_error},
             {"spp_done", s.spp_done},
             {"stopped_at_target", s.stopped_at_target}};
+  j["denoise_state"] = s.denoise_state.empty() ? json(nullptr) : json(s.denoise_state);
+  j["denoise_error"] = s.denoise_error.empty() ? json(nullptr) : json(s.denoise_error);
   j["guide"] = s.guide ? json{{"iterations", s.guide->iterations}, {"leaves", s.guide->leaves}, {"bytes", s.guide->bytes}}
                        : json(nullptr);
   // (Left out rather than null when the lease log could not be read, as before.)

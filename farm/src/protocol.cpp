@@ -112,7 +112,8 @@ json to_json(const JobSettings& s) {
             {"spp", s.spp},     {"width", s.width},         {"height", s.height},
             {"seed", s.seed},   {"tile_size", s.tile_size}, {"priority", s.priority},
             {"defines", s.defines}, {"integrator", s.integrator}, {"light_selection", s.light_selection},
-            {"target_error", s.target_error}, {"adaptive", s.adaptive}, {"webhook", s.webhook}};
+            {"target_error", s.target_error}, {"adaptive", s.adaptive}, {"denoise", s.denoise},
+            {"webhook", s.webhook}};
   j["guiding"] = s.guiding ? json(*s.guiding) : json(nullptr);
   return j;
 }
@@ -187,6 +188,7 @@ bool job_settings_from_json(const json& j, JobSettings& out, std::string& error,
   f.get("target_error", out.target_error);
   f.get("adaptive", out.adaptive);
   f.get("guiding", out.guiding);
+  f.get("denoise", out.denoise);
   f.get("webhook", out.webhook);
   f.finish();
   if (!f.ok()) return false;

@@ -15,18 +15,22 @@ namespace {
 
 static_assert(std::endian::native == std::endian::little, "the tile format is little-endian");
 constexpr char kMagic[4] = {'T', 'S', 'T', 'R'};
-// Version 3 adds training records; version 2 ends in an XXH3-128 checksum; version 1 (results and
-// checkpoints stored by earlier versions) in a SHA-256. The checksum guards against corruption in
-// transit and on disk, not against an adversary (tokens do that), and SHA-256 was a tenth of the
-// coordinator's time per unit.
-constexpr uint32_t kVersion = 3;
+// Version 4 adds the AOV sums; version 3 training records; version 2 ends in an XXH3-128 checksum;
+// version 1 (results and checkpoints stored by earlier versions) in a SHA-256. The checksum guards
+// against corruption in transit and on disk, not against an adversary (tokens do that), and SHA-256
+// was a tenth of the coordinator's time per unit.
+constexpr uint32_t kVersion = 4;
+constexpr uint32_t kVersionNoAovs = 3;
 constexpr uint32_t kVersionNoTraining = 2;
 constexpr uint32_t kVersionSha256 = 1;
 constexpr size_t kHeaderBytes = 4 + 4 + 8 + 4 + 4 + 16 + 8 + 5 * 8 + 8;
 constexpr size_t kPixelBytes = 7 * 8;
 constexpr size_t kMaxDigestBytes = sizeof(Sha256Digest);
+constexpr size_t kAovBytes = 11 * 8;
 static_assert(sizeof(PixelSums) == kPixelBytes && std::is_trivially_copyable_v<PixelSums>,
               "pixel sums are copied to and from the format as they lie in memory");
+static_assert(sizeof(AovSums) == kAovBytes && std::is_trivially_copyable_v<AovSums>,
+              "AOV sums are copied to and from the format as they lie in memory");
 
 size_t digest_bytes(uint32_t version) { return version == kVersionSha256 ? sizeof(Sha256Digest) : kTileResultDigestBytes; }
 
@@ -76,6 +80,8 @@ std::string encode_tile_result(const TileResult& r, int level) {
   raw.append(reinterpret_cast<const char*>(r.film.pixels().data()), r.film.pixels().size() * kPixelBytes);
   put(raw, uint64_t(r.training.size()));
   raw.append(r.training);
+  put(raw, uint64_t(r.film.aovs().size()));
+  raw.append(reinterpret_cast<const char*>(r.film.aovs().data()), r.film.aovs().size() * kAovBytes);
   const auto digest = checksum(raw);
   raw.append(digest.data(), digest.size());
   if (level == kUncompressed) return raw;
@@ -93,7 +99,7 @@ namespace {
 // exceeds what `max_pixels` allows.
 bool decompressed_size(std::string_view bytes, unsigned long long& size, std::string& error, int64_t max_pixels) {
   const unsigned long long max_size =
-      kHeaderBytes + kMaxDigestBytes + (unsigned long long)max_pixels * kPixelBytes + 8 + kMaxTrainingBytes;
+      kHeaderBytes + kMaxDigestBytes + (unsigned long long)max_pixels * (kPixelBytes + kAovBytes) + 16 + kMaxTrainingBytes;
   size = 0;
   for (size_t pos = 0; pos < bytes.size();) {
     const unsigned long long n = ZSTD_getFrameContentSize(bytes.data() + pos, bytes.size() - pos);
@@ -161,7 +167,7 @@ bool decode_tile_result(std::string_view bytes, TileResult& out, std::string& er
   }
   rd.pos = 4;
   const uint32_t version = rd.get<uint32_t>();
-  if (version != kVersion && version != kVersionNoTraining && version != kVersionSha256) {
+  if (version != kVersion && version != kVersionNoAovs && version != kVersionNoTraining && version != kVersionSha256) {
     error = "tile result: format version " + std::to_string(version) + ", expected " + std::to_string(kVersion);
     return false;
   }
@@ -177,27 +183,36 @@ bool decode_tile_result(std::string_view bytes, TileResult& out, std::string& er
   rect.y0 = rd.get<int32_t>();
   rect.x1 = rd.get<int32_t>();
   rect.y1 = rd.get<int32_t>();
-  const size_t pixel_end = kHeaderBytes + size_t(rect.area()) * kPixelBytes;
-  const size_t body = raw.size() - digest_bytes(version);
-  uint64_t training = 0;
-  if (version == kVersion && body >= pixel_end + 8) std::memcpy(&training, raw.data() + pixel_end, 8);
-  const size_t extra = version == kVersion ? 8 + size_t(std::min<uint64_t>(training, kMaxTrainingBytes + 1)) : 0;
   if (rect.area() > max_pixels) {
     error = "tile result: " + std::to_string(rect.area()) + " pixels, over the limit of " + std::to_string(max_pixels);
     return false;
   }
-  if (rect.empty() || rect.x0 < 0 || rect.y0 < 0 || training > kMaxTrainingBytes || body != pixel_end + extra) {
+  const size_t pixel_end = kHeaderBytes + size_t(rect.area()) * kPixelBytes;
+  const size_t body = raw.size() - digest_bytes(version);
+  // Version 3 on: u64 training bytes and the records; version 4 on: u64 AOV pixels and their sums.
+  uint64_t training = 0, aov_pixels = 0;
+  if (version >= kVersionNoAovs && body >= pixel_end + 8) std::memcpy(&training, raw.data() + pixel_end, 8);
+  training = std::min<uint64_t>(training, kMaxTrainingBytes + 1);
+  const size_t aov_at = pixel_end + 8 + size_t(training);
+  if (version >= kVersion && body >= aov_at + 8) std::memcpy(&aov_pixels, raw.data() + aov_at, 8);
+  const bool aovs_fit = aov_pixels == 0 || aov_pixels == uint64_t(rect.area());
+  const size_t extra = version < kVersionNoAovs ? 0
+                       : version == kVersionNoAovs ? 8 + size_t(training)
+                                                    : 16 + size_t(training) + (aovs_fit ? size_t(aov_pixels) * kAovBytes : 0);
+  if (rect.empty() || rect.x0 < 0 || rect.y0 < 0 || training > kMaxTrainingBytes || !aovs_fit ||
+      body != pixel_end + extra) {
     error = "tile result: pixel data does not match the tile's rectangle";
     return false;
   }
   out.sample_begin = rd.get<uint32_t>();
   out.sample_end = rd.get<uint32_t>();
-  out.film.reset(rect);
+  out.film.reset(rect, aov_pixels > 0);
   RenderCounters& c = out.film.counters;
   for (uint64_t* v : {&c.samples, &c.camera_rays, &c.bounce_rays, &c.shadow_rays, &c.nonfinite}) *v = rd.get<uint64_t>();
   out.seconds = rd.get<double>();
   std::memcpy(out.film.mutable_pixels().data(), raw.data() + rd.pos, out.film.pixels().size() * kPixelBytes);
   out.training.assign(raw.data() + pixel_end + (extra ? 8 : 0), size_t(training));
+  if (aov_pixels > 0) std::memcpy(out.film.mutable_aovs().data(), raw.data() + aov_at + 8, size_t(aov_pixels) * kAovBytes);
   return true;
 }
 

@@ -1,6 +1,6 @@
 // One background thread that runs tasks in the order they were queued: the coordinator's work that
 // must not run under its lock nor hold up a request (writing a finished job's image, and then its
-// webhook). Destruction runs what is queued, then stops.
+// webhook; denoising). Destruction runs what is queued (or drops what has not begun: OnStop), then stops.
 #pragma once
 
 #include <condition_variable>
@@ -13,11 +13,14 @@ namespace tessera::server {
 
 class BackgroundQueue {
  public:
-  BackgroundQueue() : thread_([this] { run(); }) {}
+  /// What destruction does with tasks not yet begun.
+  enum class OnStop { RunQueued, DropQueued };
+  explicit BackgroundQueue(OnStop on_stop = OnStop::RunQueued) : on_stop_(on_stop), thread_([this] { run(); }) {}
   ~BackgroundQueue() {
     {
       std::lock_guard<std::mutex> lock(mu_);
       stopping_ = true;
+      if (on_stop_ == OnStop::DropQueued) tasks_.clear();
     }
     cv_.notify_one();
     thread_.join();
@@ -47,6 +50,7 @@ class BackgroundQueue {
     }
   }
 
+  const OnStop on_stop_;
   std::mutex mu_;
   std::condition_variable cv_;
   std::deque<std::function<void()>> tasks_;

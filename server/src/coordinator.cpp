@@ -3,6 +3,7 @@
 #include "disk_full.h"
 #include "event_log.h"
 
+#include "tessera/denoise/denoiser.h"
 #include "tessera/farm/guide_artifact.h"
 #include "tessera/farm/sample_counts.h"
 #include "tessera/farm/sha256.h"
@@ -29,6 +30,7 @@ Status internal_error(const std::exception& e) {
 int http_status(Code code) {
   switch (code) {
     case Code::Ok: return 200;
+    case Code::NotYet: return 202;
     case Code::BadRequest: return 400;
     case Code::NotFound: return 404;
     case Code::Conflict: return 409;
@@ -94,7 +96,7 @@ Coordinator::Coordinator(CoordinatorOptions options) : impl_(std::make_unique<Im
     s.save_decisions(job);
     passes += job.done_units();
     if (!is_terminal(job.phase) && job.complete()) {  // its last result landed before a crash
-      (void)s.change_phase(job, JobPhase::Done);
+      s.complete_job(job);
     } else if (is_terminal(job.phase)) {
       s.finish_job(job, /*notify=*/false);  // it ended before its image was written
     } else {
@@ -191,7 +193,7 @@ std::unique_ptr<JobState> Coordinator::Impl::rebuild_job(const JobRow& row) {
     std::string err;
     if (!decode_tile_result(c.data, sums, err)) throw std::runtime_error(where + "stored checkpoint is corrupt: " + err);
     if (c.tile >= job->num_tiles() || c.passes == 0 || c.passes > job->num_passes() ||
-        !(sums.film.rect() == job->rect(job->unit(c.tile, 0))) ||
+        !(sums.film.rect() == job->rect(job->unit(c.tile, 0))) || sums.film.has_aovs() != job->plan().settings.denoise ||
         sums.sample_end != job->sample_end(job->unit(c.tile, c.passes - 1)))
       throw std::runtime_error(where + "stored checkpoint of tile " + std::to_string(c.tile) + " does not fit the job");
     job->restore_checkpoint(c.tile, c.passes, std::move(sums.film));
@@ -206,6 +208,8 @@ std::unique_ptr<JobState> Coordinator::Impl::rebuild_job(const JobRow& row) {
     TileResult result;
     std::string err;
     if (!decode_tile_result(r.data, result, err)) throw std::runtime_error(where + "stored result is corrupt: " + err);
+    if (result.film.has_aovs() != job->plan().settings.denoise)
+      throw std::runtime_error(where + "a stored result of pass " + std::to_string(r.pass) + " does not fit the job's AOVs");
     (void)job->add_result(unit, std::move(result.film), r.worker);
   });
   job->end_rebuild();
@@ -315,7 +319,9 @@ std::string Coordinator::Impl::image_path(uint64_t job) const {
 }
 
 void Coordinator::Impl::finish_job(JobState& job, bool notify) {
-  if (!is_terminal(job.phase) || job.image_pending) return;
+  // (A job cancelled while its images are being made: complete_job's task ends it.)
+  if (!is_terminal(job.phase) || job.image_pending || job.denoise_pending) return;
+  if (job.images_written) job.release_film();  // (a denoised job's images: complete_job)
   if (!job.has_film()) {  // its image is on disk already
     if (notify) send_webhook(job);
     return;
@@ -324,9 +330,7 @@ void Coordinator::Impl::finish_job(JobState& job, bool notify) {
   for (uint32_t t = 0; t < job.num_tiles(); ++t) checkpoint_tile(job, t, 1);
   // The image is written off the lock; until then it is served from the film.
   job.image_pending = true;
-  ImageAttributes attributes = {{"tessera_version", TESSERA_VERSION}, {"tessera_job", std::to_string(job.id())},
-                                {"tessera_spp", std::to_string(image_spp(job))},
-                                {"tessera_seed", std::to_string(job.plan().settings.seed)}};
+  ImageAttributes attributes = image_attributes(job);
   background.push([this, id = job.id(), attributes = std::move(attributes), notify] {
     std::string error;
     try {
@@ -350,7 +354,7 @@ void Coordinator::Impl::finish_job(JobState& job, bool notify) {
   });
 }
 
-std::optional<Image> Coordinator::Impl::film_image(uint64_t id, bool consistent) {
+std::optional<Image> Coordinator::Impl::film_image(uint64_t id, bool consistent, std::vector<ImageLayer>* layers) {
   constexpr int kBandPixels = 1 << 18;  // about a millisecond of conversion under the lock
   const auto find = [&]() -> const JobState* {
     auto it = jobs.find(id);
@@ -365,6 +369,11 @@ std::optional<Image> Coordinator::Impl::film_image(uint64_t id, bool consistent)
     height = job->plan().window.height();
   }
   Image image(width, height, 3);  // (allocated off the lock)
+  if (layers) {
+    layers->clear();
+    for (AovLayer l : denoise_layers())
+      layers->push_back({aov_layer_name(l), aov_channel_names(l), Image(width, height, l == AovLayer::Depth ? 1 : 3)});
+  }
   const int band = std::max(1, kBandPixels / std::max(1, width));
   uint64_t changes = 0;
   for (int y = 0; y < height;) {
@@ -378,6 +387,8 @@ std::optional<Image> Coordinator::Impl::film_image(uint64_t id, bool consistent)
       continue;
     }
     job->image_rows(image, y, std::min(height, y + band));
+    for (size_t i = 0; layers && i < layers->size(); ++i)
+      job->aov_rows(denoise_layers()[i], (*layers)[i].image, y, std::min(height, y + band));
     y += band;
   }
   return image;

@@ -168,11 +168,20 @@ struct Coordinator::Impl {
   /// background (off the lock); then its film is dropped and (with `notify`) its webhook called.
   /// An image a full disk kept from being written is tried again by the retention pass.
   void finish_job(JobState& job, bool notify);
+  /// Under `mu` (job_denoise.cpp): a job whose last unit is in. Done; or, for a denoised job, first
+  /// its raw image with the AOV layers and the denoised image are written off the lock on the
+  /// `denoising` queue, and the job is Done once both are stored (with a denoise error, the raw one
+  /// alone).
+  void complete_job(JobState& job);
+  std::string denoised_path(uint64_t job) const;
+  /// The EXR header entries of a job's image.
+  ImageAttributes image_attributes(const JobState& job) const;
   /// Not under `mu`: the job's image from its film, converted a band of rows at a time so that a
   /// large film never holds the lock for long; nullopt if the job or its film is gone.
   /// `consistent`: start again if the film changes between bands (an ended job's image); else a
-  /// running job's preview may join bands a few results apart.
-  std::optional<Image> film_image(uint64_t id, bool consistent);
+  /// running job's preview may join bands a few results apart. `layers`, if given, receives the
+  /// denoiser's AOV layers (denoise_layers()) from the same bands.
+  std::optional<Image> film_image(uint64_t id, bool consistent, std::vector<ImageLayer>* layers = nullptr);
   /// Under `mu`: the job's webhook, if it has one, with its status.
   void send_webhook(const JobState& job);
   std::string image_path(uint64_t job) const;
@@ -227,6 +236,9 @@ struct Coordinator::Impl {
                         callbacks();
                       },
                       std::chrono::microseconds(int64_t(opt.commit_interval * 1e6))};
+  // Denoising finished jobs, one at a time (complete_job). Destroyed first: a task queued but not
+  // begun is dropped (the job is found complete again at start-up), a running one ends normally.
+  BackgroundQueue denoising{BackgroundQueue::OnStop::DropQueued};
 };
 
 double wall_seconds();

@@ -279,6 +279,13 @@ JobStatus Coordinator::Impl::status_of(const JobState& job) const {
   s.state = phase_name(job.phase);
   s.priority = job.priority();
   s.error = job.error;
+  if (p.settings.denoise) {
+    // (A Done job's error is its denoise error: complete_job.)
+    s.denoise_state = job.phase == JobPhase::Done ? (job.error.empty() ? "done" : "failed")
+                      : job.denoise_pending       ? "running"
+                                                  : "waiting";
+    if (job.phase == JobPhase::Done) std::swap(s.error, s.denoise_error);
+  }
   s.settings = p.settings;
   s.scene_file = p.scene_file;
   s.width = p.window.width();
@@ -348,7 +355,21 @@ Result<std::vector<JobSummary>> Coordinator::list_jobs() {
   return list;
 }
 
-Result<ImageBytes> Coordinator::job_image(uint64_t id, const std::string& format) {
+// Under `mu`: why a job has no denoised image to serve yet (202) or at all (404); OK if it has.
+Status denoised_image_status(const JobState& job) {
+  const std::string name = "job " + std::to_string(job.id());
+  if (!job.plan().settings.denoise)
+    return make_error(Code::NotFound, "not_denoised", name + " was not submitted with denoise");
+  if (job.phase == JobPhase::Done && !job.error.empty())
+    return make_error(Code::NotFound, "denoise_failed", name + ": " + job.error);
+  if (job.phase != JobPhase::Done)
+    return make_error(Code::NotYet, "not_denoised_yet",
+                      name + "'s denoised image is made once its units are done (denoise_state " +
+                          (job.denoise_pending ? "running" : "waiting") + ")");
+  return Status::success();
+}
+
+Result<ImageBytes> Coordinator::job_image(uint64_t id, const std::string& format, bool denoised) {
   Impl& s = *impl_;
   if (format != "exr" && format != "png" && format != "pfm")
     return make_error(Code::BadRequest, "bad_format", "format '" + format + "' is not exr, png or pfm");
@@ -360,16 +381,26 @@ Result<ImageBytes> Coordinator::job_image(uint64_t id, const std::string& format
     std::lock_guard<std::mutex> lock(s.mu);
     auto it = s.jobs.find(id);
     if (it == s.jobs.end()) return s.missing_job(id);
+    if (denoised)
+      if (Status st = denoised_image_status(*it->second); !st.ok()) return st;
     plan = it->second->plan();
     spp = image_spp(*it->second);
-    from_film = it->second->has_film();
+    from_film = !denoised && it->second->has_film();
   }
   if (from_film) {  // (or released meanwhile, once its image is on disk)
     if (std::optional<Image> converted = s.film_image(id, /*consistent=*/false)) image = std::move(*converted);
   }
-  if (image.width() == 0) {  // an ended job: its image is on disk
+  if (image.width() == 0) {  // an ended job: its images are on disk
+    const std::string path = denoised ? s.denoised_path(id) : s.image_path(id);
     try {
-      image = read_exr(s.image_path(id));
+      // As stored: a denoised job's raw EXR carries the AOV layers.
+      if (format == "exr") {
+        ImageBytes out{read_file(path), "image/x-exr"};
+        std::lock_guard<std::mutex> lock(s.mu);
+        s.counters.bytes_out += out.bytes.size();
+        return out;
+      }
+      image = read_exr(path);
     } catch (const std::exception& e) {
       return internal_error(e);
     }

@@ -252,6 +252,10 @@ Result<size_t> Coordinator::Impl::check_result(uint64_t worker, const TileResult
       result.sample_end != job.sample_end(unit))
     return make_error(Code::BadRequest, "bad_result", "the result's rectangle or samples do not match the unit");
   // (A late copy of a done unit is answered as a duplicate, its sums compared with the accepted ones.)
+  if (!job.is_done(unit) && result.film.has_aovs() != job.plan().settings.denoise)
+    return make_error(Code::BadRequest, "bad_result",
+                      job.plan().settings.denoise ? "a result of a denoised job must carry the AOV sums (format version 4)"
+                                                  : "the result carries AOV sums the job did not ask for");
   if (!job.is_done(unit) && !job.result_fits(unit, result.film))
     return make_error(Code::BadRequest, "bad_result",
                       "the result's per-pixel sample counts are not those its adaptive pass gives the tile");
@@ -286,7 +290,7 @@ void Coordinator::Impl::result_committed(bool durable, uint64_t job_id, size_t u
   log_event(spdlog::level::debug, "lease.done",
             {{"job", job.id()}, {"unit", unit}, {"worker", worker}, {"seconds", result.seconds}});
   // (The phase is kept until durable; a crash before that finds the job complete at start-up.)
-  if (!is_terminal(job.phase) && job.complete()) (void)change_phase(job, JobPhase::Done);
+  if (!is_terminal(job.phase) && job.complete()) complete_job(job);
 }
 
 uint64_t Coordinator::Impl::commit_result(JobState& job, size_t unit, uint64_t worker,

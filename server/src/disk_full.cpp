@@ -98,12 +98,12 @@ void verify_image_file(const std::string& path, const std::string& format, const
 }
 
 void write_image_durably(const std::string& path, const Image& image, const ImageAttributes& attributes,
-                         const std::string& data_dir) {
+                         const std::string& data_dir, const std::vector<ImageLayer>& layers) {
   const std::string tmp = path + ".tmp.exr";
   std::error_code ec;
   try {
     try {
-      write_exr(tmp, image, attributes);
+      write_exr_layers(tmp, image, layers, attributes);
     } catch (const std::exception& e) {
       if (mentions_full_disk(e.what()) || nearly_full(data_dir)) throw_full(e.what(), data_dir);
       throw;

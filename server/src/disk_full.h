@@ -35,9 +35,9 @@ uint64_t disk_full_errors();
 /// Writes a job's EXR durably: to a temporary name, read back and compared bit for bit (OpenEXR
 /// and the C++ streams drop errors that happen when the file is closed, so a full disk can
 /// truncate a file whose writer reported success), fsync'd, renamed. On failure nothing is left
-/// and a full disk throws DiskFullError.
+/// and a full disk throws DiskFullError. `layers` (AOVs) are written beside the image.
 void write_image_durably(const std::string& path, const Image& image, const ImageAttributes& attributes,
-                         const std::string& data_dir);
+                         const std::string& data_dir, const std::vector<ImageLayer>& layers = {});
 /// Checks a freshly written image file (`format` exr, pfm or png) decodes to `image`'s size (exr:
 /// to its exact bits); throws DiskFullError when it does not and the disk is full, else
 /// std::runtime_error.

@@ -233,7 +233,9 @@ void install_routes(httplib::Server& http, Coordinator& c, uint64_t max_upload_b
   http.Get(R"(/api/v1/jobs/(\d+)/image)", [&c](const httplib::Request& req, httplib::Response& res) {
     uint64_t id;
     if (!parse_id(req, 1, id, res)) return;
-    Result<ImageBytes> image = c.job_image(id, req.has_param("format") ? req.get_param_value("format") : "exr");
+    const bool denoised = req.has_param("denoised") && req.get_param_value("denoised") != "0";
+    Result<ImageBytes> image =
+        c.job_image(id, req.has_param("format") ? req.get_param_value("format") : "exr", denoised);
     if (!image.ok()) return send_error(res, image.status);
     res.set_content(image.value.bytes, image.value.content_type.c_str());
   });

@@ -103,6 +103,10 @@ Image JobState::image() const {
   return Image(plan_.window.width(), plan_.window.height(), 3);
 }
 
+void JobState::aov_rows(AovLayer layer, Image& img, int row_begin, int row_end) const {
+  if (film_ && (film_->has_aovs() || layer == AovLayer::Variance)) film_->aov_rows(layer, img, row_begin, row_end);
+}
+
 void JobState::image_rows(Image& img, int row_begin, int row_end) const {
   if (film_) film_->to_image_rows(img, row_begin, row_end);  // (else black, as allocated)
 }
@@ -194,7 +198,7 @@ bool JobState::add_result(size_t unit, FilmTile&& tile, uint64_t worker, std::st
 
   // Passes of a tile enter the film in pass order; a later pass waits for the earlier ones.
   const uint32_t t = tile_of(unit);
-  if (!film_ && !film_released_) film_ = std::make_unique<Film>(plan_.window, plan_.full_width, plan_.full_height);
+  allocate_film();
   waiting_.emplace(unit, std::move(tile));
   for (auto it = waiting_.find(this->unit(t, next_pass_[t])); it != waiting_.end();
        it = waiting_.find(this->unit(t, next_pass_[t]))) {
@@ -215,12 +219,15 @@ JobState::Checkpoint JobState::film_checkpoint(uint32_t t) const {
   cp.from = folded_[t];
   cp.passes = next_pass_[t];
   const TileRect& r = tiles_[t];
-  cp.sums.reset(r);
+  cp.sums.reset(r, plan_.settings.denoise);
   if (film_) {
     std::vector<PixelSums>& out = cp.sums.mutable_pixels();
     for (int y = r.y0; y < r.y1; ++y)
-      for (int x = r.x0; x < r.x1; ++x)
-        out[size_t(y - r.y0) * size_t(r.width()) + size_t(x - r.x0)] = film_->pixel({x, y});
+      for (int x = r.x0; x < r.x1; ++x) {
+        const size_t i = size_t(y - r.y0) * size_t(r.width()) + size_t(x - r.x0);
+        out[i] = film_->pixel({x, y});
+        if (cp.sums.has_aovs()) cp.sums.mutable_aovs()[i] = film_->aov({x, y});
+      }
   }
   cp.sums.counters = tile_counters_[t];
   return cp;
@@ -250,13 +257,19 @@ std::optional<JobState::Checkpoint> JobState::checkpoint_with(size_t u, const Fi
       out[i].sum_sq[c] += in[i].sum_sq[c];
     }
     out[i].count += in[i].count;
+    if (cp.sums.has_aovs()) add_aov_sums(cp.sums.mutable_aovs()[i], result.aovs()[i]);
   }
   cp.sums.counters += result.counters;
   return cp;
 }
 
+void JobState::allocate_film() {
+  if (!film_ && !film_released_)
+    film_ = std::make_unique<Film>(plan_.window, plan_.full_width, plan_.full_height, plan_.settings.denoise);
+}
+
 void JobState::restore_checkpoint(uint32_t t, uint32_t passes, FilmTile&& sums) {
-  if (!film_ && !film_released_) film_ = std::make_unique<Film>(plan_.window, plan_.full_width, plan_.full_height);
+  allocate_film();
   if (film_) film_->add_tile(sums);
   ++film_changes_;
   counters_ += sums.counters;

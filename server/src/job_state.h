@@ -187,6 +187,8 @@ class JobState {
   Image image() const;
   /// Rows [row_begin, row_end) of image() into `img` (of the window's size). Only with has_film().
   void image_rows(Image& img, int row_begin, int row_end) const;
+  /// The same for an AOV layer (render/aov.h) of a denoised job's film.
+  void aov_rows(AovLayer layer, Image& img, int row_begin, int row_end) const;
   /// Counts every change of the film's sums (a result or checkpoint added).
   uint64_t film_changes() const { return film_changes_; }
   /// The sums so far; only once a result has arrived (film_allocated()).
@@ -223,6 +225,10 @@ class JobState {
   uint64_t lease_bytes = 0;   // JSON bytes of the leases handed out
   size_t lease_job_part_bytes = 0;  // of each lease's job part (0: not measured yet; see protocol.h)
   bool image_pending = false;  // an ended job's image is being written (its film is kept until then)
+  // A denoised job whose units are all in: its images are being made (job_denoise.cpp), and then
+  // whether they were written (finish_job then only drops the film).
+  bool denoise_pending = false;
+  bool images_written = false;
 
  private:
   uint64_t id_;
@@ -245,6 +251,7 @@ class JobState {
   void advance_passes();
   bool pass_decided_before(uint32_t pass) const;
   Checkpoint film_checkpoint(uint32_t tile) const;
+  void allocate_film();  // on the first result or checkpoint (with AOV sums for a denoised job)
 
   size_t done_units_ = 0, first_open_ = 0;
   std::vector<uint32_t> pass_done_;  // per pass: tiles that have it

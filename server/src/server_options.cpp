@@ -28,6 +28,10 @@ int parse_server_args(int argc, char** argv, ServerOptions& o) {
                  "seconds: under load, the state database commits (one fsync) at most this often, every lease "
                  "and result decided meanwhile together; 0 commits as soon as the previous commit ends")
       ->check(CLI::Range(0.0, 0.1))->capture_default_str();
+  app.add_option("--denoise-threads", c.denoise_threads,
+                 "threads that denoise a finished job's image (jobs with denoise), one job at a time; 0: every core. "
+                 "The image does not depend on it")
+      ->check(CLI::Range(0, 256))->capture_default_str();
 
   auto* security = "Security";
   app.add_option("--client-token", o.client_token, "bearer token for clients (else $TESSERA_CLIENT_TOKEN)")->group(security);

@@ -2,6 +2,7 @@
 // finished image is compared bit for bit with an in-process render of the same settings, which is
 // what `tessera render` produces.
 #include "farm_harness.h"
+#include "tessera/denoise/denoiser.h"
 
 #include <iterator>
 
@@ -332,6 +333,32 @@ TEST(FarmIntegration, SubmitCommandDownloadsTheSameImage) {
   std::string xml = bad.write("bad.xml", "<scene version=\"0.6.0\"><shape type=\"obj\"/></scene>");
   EXPECT_NE(std::system((cli + "submit " + xml + " --server " + farm.url() + " > " + jobs + " 2>&1").c_str()), 0);
   EXPECT_EQ(farm.client().get("/api/v1/jobs").json()["jobs"].size(), 1u);
+}
+
+// A denoised job as users run it, on two workers: `tessera submit --denoise -o OUT.exr` writes the
+// denoised image and OUT.noisy.exr; the raw one (image and AOV layers) is `tessera render --aovs
+// all`'s, and the denoised one is what `tessera denoise` makes of that raw image, bit for bit.
+TEST(FarmIntegration, DenoisedJobIsTheLocalRenderAndItsDenoisedImage) {
+  TESSERA_REQUIRE_FILE(cornell());
+  Farm farm;
+  farm.start_server();
+  farm.add_worker(1);
+  farm.add_worker(1);
+  ASSERT_TRUE(farm.wait_workers(2));
+  const std::string out = (farm.dir().path / "dn.exr").string(), noisy = (farm.dir().path / "dn.noisy.exr").string();
+  const std::string local = (farm.dir().path / "local.exr").string(), again = (farm.dir().path / "again.exr").string();
+  const std::string cli = std::string(TESSERA_CLI_BIN) + " ";
+  const std::string flags = " --spp 37 --width 100 --height 75 --tile-size 24 --seed 11 -q";
+  const std::string log = " > " + farm.log("denoise") + " 2>&1";
+  ASSERT_EQ(std::system((cli + "submit " + cornell() + " --server " + farm.url() + flags + " --denoise -o " + out + log).c_str()), 0);
+  ASSERT_EQ(std::system((cli + "render " + cornell() + flags + " --aovs all -o " + local + log).c_str()), 0);
+  ASSERT_EQ(std::system((cli + "denoise " + noisy + " -o " + again + log).c_str()), 0);
+  const DenoiseInput raw = read_denoise_input(noisy), expected = read_denoise_input(local);
+  EXPECT_EQ(raw.color.values(), expected.color.values());
+  EXPECT_EQ(raw.normal.values(), expected.normal.values());
+  EXPECT_EQ(raw.half_b.values(), expected.half_b.values());
+  EXPECT_EQ(read_exr(out).values(), read_exr(again).values());
+  EXPECT_EQ(read_exr(out).values(), denoise(expected).values());
 }
 
 }  // namespace

@@ -4,6 +4,8 @@
 #include "tessera/farm/sha256.h"
 
 #include <gtest/gtest.h>
+#define XXH_INLINE_ALL
+#include <xxhash.h>
 #include <zstd.h>
 
 #include <cstring>
@@ -103,7 +105,7 @@ std::string zstd_frame(std::string_view raw) {
 TEST(TileResult, StoredUncompressedRoundTripsAndIsChecked) {
   const TileResult in = sample_result();
   const std::string raw = encode_tile_result(in, kUncompressed);
-  EXPECT_EQ(raw.size(), size_t(96 + 13 * 9 * 56 + 8 + kTileResultDigestBytes));
+  EXPECT_EQ(raw.size(), size_t(96 + 13 * 9 * 56 + 8 + 8 + kTileResultDigestBytes));
   EXPECT_EQ(raw.substr(0, 4), "TSTR");
   TileResult out;
   std::string error;
@@ -122,7 +124,7 @@ TEST(TileResult, StoredUncompressedRoundTripsAndIsChecked) {
 TEST(TileResult, ReadsVersionOneWithSha256) {
   const TileResult in = sample_result();
   std::string v1 = encode_tile_result(in, kUncompressed);
-  v1.resize(v1.size() - kTileResultDigestBytes - 8);  // (and without version 3's training records)
+  v1.resize(v1.size() - kTileResultDigestBytes - 16);  // (without version 3's training records and 4's AOVs)
   const uint32_t version = 1;
   std::memcpy(v1.data() + 4, &version, 4);
   const Sha256Digest digest = sha256(v1);
@@ -137,6 +139,48 @@ TEST(TileResult, ReadsVersionOneWithSha256) {
   std::memcpy(v1.data() + 4, "\x09\0\0\0", 4);
   EXPECT_FALSE(decode_tile_result(v1, out, error));
   EXPECT_NE(error.find("version 9"), std::string::npos) << error;
+}
+
+// A denoised job's units carry the AOV sums (format version 4); version 3 results, without them,
+// are still read.
+TEST(TileResult, AovSumsRoundTripAndVersionThreeIsRead) {
+  TileResult in = sample_result();
+  FilmTile with_aovs({10, 20, 23, 29}, /*aovs=*/true);
+  SampleFeatures f;
+  f.albedo = Rgb(0.25f, 0.5f, 0.75f);
+  f.normal = Vec3(0.f, 0.f, 1.f);
+  f.depth = 3.5f;
+  for (int y = 20; y < 29; ++y)
+    for (int x = 10; x < 23; ++x)
+      for (uint32_t s = 0; s < 3; ++s) with_aovs.add_sample({x, y}, Rgb(float(x), float(y), float(s)), s, f);
+  in.film = with_aovs;
+  const std::string raw = encode_tile_result(in, kUncompressed);
+  EXPECT_EQ(raw.size(), size_t(96 + 13 * 9 * (56 + 88) + 8 + 8 + kTileResultDigestBytes));
+  TileResult out;
+  std::string error;
+  ASSERT_TRUE(decode_tile_result(encode_tile_result(in), out, error)) << error;
+  ASSERT_TRUE(out.film.has_aovs());
+  EXPECT_EQ(std::memcmp(out.film.aovs().data(), in.film.aovs().data(), in.film.aovs().size() * sizeof(AovSums)), 0);
+  EXPECT_EQ(out.film.aovs()[0].half_count, 2u);
+
+  // A count of AOV pixels that is not the rectangle's is refused.
+  std::string bad = raw;
+  const size_t count_at = 96 + 13 * 9 * 56 + 8;
+  const uint64_t wrong = 5;
+  std::memcpy(bad.data() + count_at, &wrong, 8);
+  EXPECT_FALSE(decode_tile_result(bad, out, error));
+
+  // Version 3: the same without the AOV block (and its checksum over those bytes).
+  std::string v3 = encode_tile_result(sample_result(), kUncompressed);
+  v3.erase(v3.size() - kTileResultDigestBytes - 8);
+  const uint32_t version = 3;
+  std::memcpy(v3.data() + 4, &version, 4);
+  XXH128_canonical_t c;
+  XXH128_canonicalFromHash(&c, XXH3_128bits(v3.data(), v3.size()));
+  v3.append(reinterpret_cast<const char*>(c.digest), sizeof(c.digest));
+  ASSERT_TRUE(decode_tile_result(v3, out, error)) << error;
+  EXPECT_FALSE(out.film.has_aovs());
+  EXPECT_TRUE(same_result(sample_result(), out));
 }
 
 TEST(TileResult, ConcatenatedFramesDecodeAsOne) {

@@ -129,10 +129,16 @@ void Film::to_image_rows(Image& img, int row_begin, int row_end) const {
 }
 
 Image Film::aov_image(AovLayer layer) const {
-  if (layer == AovLayer::Variance) return variance_image();
-  TESSERA_CHECK(has_aovs());
   Image img(width(), height(), layer == AovLayer::Depth ? 1 : 3);
-  for (int y = window_.y0; y < window_.y1; ++y)
+  aov_rows(layer, img, 0, height());
+  return img;
+}
+
+void Film::aov_rows(AovLayer layer, Image& img, int row_begin, int row_end) const {
+  TESSERA_CHECK(img.width() == width() && img.height() == height() && row_begin >= 0 && row_end <= height());
+  if (layer == AovLayer::Variance) return variance_rows(img, row_begin, row_end);
+  TESSERA_CHECK(has_aovs() && img.channels() == (layer == AovLayer::Depth ? 1 : 3));
+  for (int y = window_.y0 + row_begin; y < window_.y0 + row_end; ++y)
     for (int x = window_.x0; x < window_.x1; ++x) {
       const PixelSums& p = pixel({x, y});
       const AovSums& a = aov({x, y});
@@ -152,7 +158,6 @@ Image Film::aov_image(AovLayer layer) const {
       }
       for (int c = 0; c < img.channels(); ++c) img.at(x - window_.x0, y - window_.y0, c) = float(v[c]);
     }
-  return img;
 }
 
 std::vector<ImageLayer> Film::aov_layers(const std::vector<AovLayer>& layers) const {
@@ -163,13 +168,17 @@ std::vector<ImageLayer> Film::aov_layers(const std::vector<AovLayer>& layers) co
 
 Image Film::variance_image() const {
   Image img(width(), height(), 3);
-  for (int y = window_.y0; y < window_.y1; ++y)
+  variance_rows(img, 0, height());
+  return img;
+}
+
+void Film::variance_rows(Image& img, int row_begin, int row_end) const {
+  for (int y = window_.y0 + row_begin; y < window_.y0 + row_end; ++y)
     for (int x = window_.x0; x < window_.x1; ++x) {
       uint64_t n = pixel({x, y}).count;
       Rgb v = n > 0 ? sample_variance({x, y}) / float(n) : Rgb();
       img.set_rgb(x - window_.x0, y - window_.y0, v);
     }
-  return img;
 }
 
 }  // namespace tessera

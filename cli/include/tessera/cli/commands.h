@@ -56,6 +56,7 @@ struct SubmitOptions {
   double target_error = 0;           // stop at this estimated relMSE (spp is then the budget)
   std::string guiding;               // "on", "off"; empty: as the scene says
   std::string adaptive = "off";      // adaptive sampling: "on" or "off"
+  bool denoise = false;              // outputs get the denoised image, FILE.noisy.ext the raw one
   std::string webhook;               // URL the coordinator POSTs the job's status to when it ends
   std::string frames;                // "A-B": one job per frame (-D frame=N); outputs carry ####
   bool wait = false, quiet = false;
@@ -74,6 +75,8 @@ int run_render(const RenderOptions& options);
 int run_bench_rays(const BenchRaysOptions& options);
 int run_compare(const CompareOptions& options);
 int run_denoise(const DenoiseOptions& options);
+/// FILE.ext -> FILE.noisy.ext: where a denoised render's raw image goes (render and submit --denoise).
+std::string noisy_path(const std::string& path);
 int run_submit(const SubmitOptions& options);
 int run_jobs(const JobsOptions& options);
 int run_cancel(const JobsOptions& options);

@@ -55,7 +55,8 @@ class FarmApi {
   HttpReply jobs(double timeout = 30) const;
   HttpReply job(uint64_t id, double timeout = 30) const;
   /// format: exr, png or pfm.
-  HttpReply job_image(uint64_t id, const std::string& format, double timeout = 300) const;
+  /// `denoised`: the job's denoised image (a job submitted with denoise).
+  HttpReply job_image(uint64_t id, const std::string& format, bool denoised = false, double timeout = 300) const;
   HttpReply cancel_job(uint64_t id, double timeout = 30) const;
   HttpReply set_priority(uint64_t id, int priority, double timeout = 30) const;
   HttpReply retry_job(uint64_t id, double timeout = 30) const;

@@ -141,6 +141,9 @@ class Film {
   /// the mean of half A's or half B's samples (0 for a half without samples). Requires has_aovs()
   /// except for Variance.
   Image aov_image(AovLayer layer) const;
+  /// Rows [row_begin, row_end) of aov_image(layer) into `img` (the window's size, the layer's
+  /// channels): a large film converted a band at a time.
+  void aov_rows(AovLayer layer, Image& img, int row_begin, int row_end) const;
   const AovSums& aov(Vec2i p) const { return aovs_[index(p)]; }
   /// The layers, named and with channel names as written into an EXR (aov.h).
   std::vector<ImageLayer> aov_layers(const std::vector<AovLayer>& layers) const;
@@ -149,6 +152,7 @@ class Film {
 
  private:
   size_t index(Vec2i p) const { return size_t(p.y - window_.y0) * size_t(window_.width()) + size_t(p.x - window_.x0); }
+  void variance_rows(Image& img, int row_begin, int row_end) const;
   TileRect window_;
   int full_width_ = 0, full_height_ = 0;
   std::vector<PixelSums> pixels_;

@@ -45,6 +45,10 @@ struct JobStatus {
     uint64_t leaves = 0, bytes = 0;
   };
   std::optional<Guide> guide;
+  /// A denoised job's images (settings.denoise): "waiting" for its units, "running" (the raw image
+  /// and the denoised one being made), "done", or "failed" with the reason in denoise_error (the
+  /// job is done with its raw image).
+  std::string denoise_state, denoise_error;
   // From the lease log; absent when it could not be read.
   std::optional<uint64_t> leases_issued, reissued_acknowledged_passes;
 };

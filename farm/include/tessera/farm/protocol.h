@@ -37,6 +37,9 @@ struct JobSettings {
   /// Path guiding: empty lets the scene decide (its guided_path integrator asks for it). The farm
   /// does not guide yet, so a job that would be guided is refused rather than rendered otherwise.
   std::optional<bool> guiding;
+  /// Denoise the finished image (denoise/denoiser.h): units render the AOV sums too, and the job is
+  /// done once the raw image (with its AOV layers) and the denoised one are stored.
+  bool denoise = false;
   std::string webhook;          // http(s) URL POSTed the job's status when it ends; empty: none
 };
 

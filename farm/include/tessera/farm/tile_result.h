@@ -7,8 +7,11 @@
 //   u64 samples, camera_rays, bounce_rays, shadow_rays, nonfinite, f64 render seconds,
 //   per pixel (row-major over the rect): f64 sum[3], f64 sum_sq[3], u64 count,
 //   u64 n, n bytes of training records (guiding/tree_io.h; n = 0 unless the unit trains a guide),
-//   16-byte XXH3-128 checksum of everything above (big-endian canonical form). Format version 2,
-//   still read, has no training records; version 1 also ended in a 32-byte SHA-256 instead.
+//   u64 m, m per-pixel AOV sums (render/aov.h: f64 albedo[3], normal[3], depth, half_sum[3], u64
+//   half_count; m is 0, or the rect's area for a job that is denoised),
+//   16-byte XXH3-128 checksum of everything above (big-endian canonical form). Format version 3,
+//   still read, has no AOV sums; version 2 no training records either; version 1 also ended in a
+//   32-byte SHA-256 instead.
 // The coordinator adds decoded tiles to its Film exactly as render() does, so the stitched image is
 // bit-identical to a local render (render/renderer.h).
 #pragma once

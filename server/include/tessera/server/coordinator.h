@@ -33,6 +33,9 @@ struct CoordinatorOptions {
   // (seconds), taking every lease, result and phase change decided meanwhile: fewer fsyncs per
   // unit for at most this much more latency. 0: commit as soon as the previous commit ends.
   double commit_interval = 0.004;
+  // Threads the coordinator denoises a finished job's image with (job field `denoise`), one job
+  // at a time, off its lock; the image does not depend on it. 0: every core.
+  int denoise_threads = 1;
   int max_waiting_polls = 16;     // concurrent long polls; more get 204 at once (never starve clients)
   // Idle workers get a copy of a job's oldest outstanding unit once it has no unleased one
   // (scheduler.h); the first result wins and a later one must match it bit for bit.
@@ -94,7 +97,8 @@ class Coordinator {
   Result<JobStatus> job_status(uint64_t id);
   Result<std::vector<JobSummary>> list_jobs();
   /// format: exr, png or pfm. The partial image while running.
-  Result<ImageBytes> job_image(uint64_t id, const std::string& format);
+  /// `denoised`: the denoised image of a job with `denoise`, once it is done (202 before).
+  Result<ImageBytes> job_image(uint64_t id, const std::string& format, bool denoised = false);
   Status cancel_job(uint64_t id);
   /// Operating a job: a new priority (any time), or a failed/cancelled job queued again with the
   /// passes it already has (its failure counts cleared).

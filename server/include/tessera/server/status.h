@@ -9,6 +9,7 @@ namespace tessera::server {
 
 enum class Code {
   Ok,
+  NotYet,           // 202: not made yet (a denoised image being made); ask again
   BadRequest,       // 400: malformed input
   NotFound,         // 404
   Conflict,         // 409: e.g. a worker whose build differs
