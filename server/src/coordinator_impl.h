@@ -174,6 +174,9 @@ struct Coordinator::Impl {
   /// alone).
   void complete_job(JobState& job);
   std::string denoised_path(uint64_t job) const;
+  /// Under `mu`: queues a preview-mode denoise of a running denoised job's film on `denoising`
+  /// unless one is queued or the cached one is of the film as it is.
+  void refresh_denoised_preview(JobState& job);
   /// The EXR header entries of a job's image.
   ImageAttributes image_attributes(const JobState& job) const;
   /// Not under `mu`: the job's image from its film, converted a band of rows at a time so that a

@@ -362,10 +362,8 @@ Status denoised_image_status(const JobState& job) {
     return make_error(Code::NotFound, "not_denoised", name + " was not submitted with denoise");
   if (job.phase == JobPhase::Done && !job.error.empty())
     return make_error(Code::NotFound, "denoise_failed", name + ": " + job.error);
-  if (job.phase != JobPhase::Done)
-    return make_error(Code::NotYet, "not_denoised_yet",
-                      name + "'s denoised image is made once its units are done (denoise_state " +
-                          (job.denoise_pending ? "running" : "waiting") + ")");
+  if (is_terminal(job.phase) && job.phase != JobPhase::Done)
+    return make_error(Code::NotFound, "not_denoised", name + " is " + phase_name(job.phase) + ": no denoised image");
   return Status::success();
 }
 
@@ -377,16 +375,27 @@ Result<ImageBytes> Coordinator::job_image(uint64_t id, const std::string& format
   JobPlan plan;
   uint32_t spp = 0;
   bool from_film = false;
+  std::shared_ptr<const Image> preview;  // a running job's denoised preview
   {
     std::lock_guard<std::mutex> lock(s.mu);
     auto it = s.jobs.find(id);
     if (it == s.jobs.end()) return s.missing_job(id);
-    if (denoised)
-      if (Status st = denoised_image_status(*it->second); !st.ok()) return st;
-    plan = it->second->plan();
-    spp = image_spp(*it->second);
-    from_film = !denoised && it->second->has_film();
+    JobState& job = *it->second;
+    if (denoised) {
+      if (Status st = denoised_image_status(job); !st.ok()) return st;
+      if (job.phase != JobPhase::Done) {  // the latest preview denoised, a newer one on its way
+        s.refresh_denoised_preview(job);
+        if (!job.denoised_preview)
+          return make_error(Code::NotYet, "not_denoised_yet",
+                            "job " + std::to_string(id) + "'s denoised image is being made; ask again");
+        preview = job.denoised_preview;
+      }
+    }
+    plan = job.plan();
+    spp = image_spp(job);
+    from_film = !denoised && job.has_film();
   }
+  if (preview) image = *preview;
   if (from_film) {  // (or released meanwhile, once its image is on disk)
     if (std::optional<Image> converted = s.film_image(id, /*consistent=*/false)) image = std::move(*converted);
   }

@@ -70,4 +70,32 @@ void Coordinator::Impl::complete_job(JobState& job) {
   });
 }
 
+void Coordinator::Impl::refresh_denoised_preview(JobState& job) {
+  if (job.preview_denoise_pending || job.denoise_pending || is_terminal(job.phase)) return;
+  if (job.denoised_preview && job.denoised_preview_changes == job.film_changes()) return;
+  job.preview_denoise_pending = true;
+  denoising.push([this, id = job.id(), changes = job.film_changes()] {
+    std::shared_ptr<const Image> preview;
+    try {
+      std::vector<ImageLayer> layers;
+      if (const std::optional<Image> raw = film_image(id, /*consistent=*/false, &layers)) {
+        DenoiseSettings settings;
+        settings.mode = DenoiseMode::Preview;
+        settings.threads = opt.denoise_threads;
+        preview = std::make_shared<const Image>(denoise(make_denoise_input(*raw, layers), settings));
+      }
+    } catch (const std::exception& e) {
+      spdlog::warn("job {}: preview not denoised: {}", id, e.what());
+    }
+    std::lock_guard<std::mutex> lock(mu);
+    auto it = jobs.find(id);
+    if (it == jobs.end()) return;
+    JobState& j = *it->second;
+    j.preview_denoise_pending = false;
+    if (!preview || is_terminal(j.phase)) return;
+    j.denoised_preview = std::move(preview);
+    j.denoised_preview_changes = changes;
+  });
+}
+
 }  // namespace tessera::server

@@ -204,6 +204,7 @@ class JobState {
     if (film_) (void)noise();  // kept for the finished job's status
     film_.reset();
     film_released_ = true;
+    denoised_preview.reset();
     if (plans_) plans_->release_pixels();
     if (guide_) guide_->release_trees();
     waiting_.clear();
@@ -229,6 +230,11 @@ class JobState {
   // whether they were written (finish_job then only drops the film).
   bool denoise_pending = false;
   bool images_written = false;
+  // A running denoised job's preview, denoised (refresh_denoised_preview): the latest made, the
+  // film_changes() it was made at, and whether a newer one is being made.
+  std::shared_ptr<const Image> denoised_preview;
+  uint64_t denoised_preview_changes = 0;
+  bool preview_denoise_pending = false;
 
  private:
   uint64_t id_;

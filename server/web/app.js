@@ -14,7 +14,8 @@
     token: sessionStorage.getItem(TOKEN_KEY) || '',
     selected: null,  // the job id in the detail panel
     // key: the shown image's job and samples; next: no fetch before (big images cost the server a PNG)
-    image: { job: null, key: '', url: null, busy: false, next: 0 },
+    // kind: 'raw', or 'denoised' for a job submitted with denoise (the toggle above the image)
+    image: { job: null, key: '', url: null, busy: false, next: 0, kind: 'raw' },
     jobRows: new Map(),  // job id -> <tr>, updated in place so buttons survive each poll
     timer: null,
     running: false,
@@ -254,16 +255,28 @@
 
   // The PNG is fetched (the <img> cannot send the token) only when the job has new samples, and
   // no more often than every five times its last download took.
+  // A denoised job's image can be shown denoised: while it runs a denoised preview (202 while the
+  // coordinator makes one), once done the final denoised image.
   async function refreshImage(job) {
-    const key = `${job.id}:${job.samples_done}`;
+    const denoise = Boolean(job.settings && job.settings.denoise);
+    $('image-choice').hidden = !denoise;
+    const kind = denoise ? state.image.kind : 'raw';
+    const key = `${job.id}:${job.samples_done}:${job.state}:${kind}`;
     const img = $('preview');
     if (job.samples_done === 0 || key === state.image.key || state.image.busy) return;
     if (job.id === state.image.job && performance.now() < state.image.next) return;
     state.image.busy = true;
     const started = performance.now();
     try {
-      const blob = await (await api(`/api/v1/jobs/${job.id}/image?format=png`)).blob();
+      const res = await api(`/api/v1/jobs/${job.id}/image?format=png${kind === 'denoised' ? '&denoised=1' : ''}`);
       if (state.selected !== job.id) return;  // the user moved on meanwhile
+      if (res.status === 202) {  // being denoised: ask again in a second
+        $('image-note').textContent = 'being denoised…';
+        state.image.next = performance.now() + 1000;
+        return;
+      }
+      $('image-note').textContent = '';
+      const blob = await res.blob();
       const old = state.image.url;
       state.image.url = URL.createObjectURL(blob);
       state.image.job = job.id;
@@ -273,6 +286,7 @@
       img.onload = () => {
         if (old) URL.revokeObjectURL(old);
         img.dataset.jobId = job.id;
+        img.dataset.kind = kind;
         img.dataset.complete = String(job.samples_done >= job.samples_total);
       };
       img.src = state.image.url;
@@ -386,6 +400,7 @@
     if (text('scene-file')) settings.scene_file = text('scene-file');
     for (const [id, field] of [['width', 'width'], ['height', 'height'], ['spp', 'spp'], ['priority', 'priority']])
       if (text(id) !== '') settings[field] = Number.parseInt(text(id), 10);
+    if ($('denoise').checked) settings.denoise = true;
     const form = new FormData();
     form.append('settings', new Blob([JSON.stringify(settings)], { type: 'application/json' }), 'settings.json');
     form.append('bundle', file, file.name);
@@ -416,6 +431,14 @@
   });
   $('token-forget').addEventListener('click', () => setToken(''));
   $('submit-form').addEventListener('submit', submitJob);
+  for (const radio of document.querySelectorAll('input[name="image-kind"]')) {
+    radio.addEventListener('change', () => {
+      state.image.kind = radio.value;
+      state.image.key = '';
+      state.image.next = 0;
+      refreshSoon();
+    });
+  }
   document.addEventListener('visibilitychange', () => !document.hidden && refreshSoon());
   tick();
 })();

@@ -192,12 +192,14 @@ def job_row(driver, job_id):
     return driver.execute_script(JOB_ROW_JS, str(job_id))
 
 
-def submit(driver, bundle, name, width, height, spp):
+def submit(driver, bundle, name, width, height, spp, denoise=False):
     previous = driver.find_element(By.ID, "submit-result").get_attribute("data-job-id")
     for field, value in (("job-name", name), ("width", width), ("height", height), ("spp", spp)):
         box = driver.find_element(By.ID, field)
         box.clear()
         box.send_keys(str(value))
+    if driver.find_element(By.ID, "denoise").is_selected() != denoise:
+        driver.find_element(By.ID, "denoise").click()
     driver.find_element(By.ID, "bundle").send_keys(str(bundle))
     driver.find_element(By.ID, "submit-button").click()
 
@@ -308,6 +310,20 @@ def run(args, tmp):
         check(server.job(long_id)["state"] == "cancelled", "the API does not say cancelled")
         check(not job_row(driver, long_id)["cancel_visible"], "a cancelled job still has a cancel button")
         print(f"job #{long_id} cancelled from the page")
+
+        # A denoised job (the form's checkbox): once done, the toggle shows its denoised image.
+        dn_id = submit(driver, bundle, "denoised", args.width, args.height, args.spp, denoise=True)
+        wait_for(driver, args.timeout, f"job #{dn_id} to finish",
+                 lambda d: (job_row(d, dn_id) or {}).get("state") == "done")
+        check(server.job(dn_id)["denoise_state"] == "done", f"the API says {server.job(dn_id)['denoise_state']}")
+        wait_for(driver, 20, "the raw/denoised toggle", lambda d: d.find_element(By.ID, "image-choice").is_displayed())
+        driver.find_element(By.CSS_SELECTOR, 'input[name="image-kind"][value="denoised"]').click()
+        shown = wait_for(driver, 60, f"job #{dn_id}'s denoised image", lambda d: d.execute_script(
+            "const i = document.getElementById('preview');"
+            "return i.dataset.jobId === arguments[0] && i.dataset.kind === 'denoised' && i.complete && "
+            "i.naturalWidth > 0 ? [i.naturalWidth, i.naturalHeight] : null;", str(dn_id)))
+        check(tuple(shown) == (args.width, args.height), f"denoised image {shown}")
+        print(f"job #{dn_id} shown denoised ({shown[0]}x{shown[1]})")
 
         errors = severe(driver.get_log("browser"))
         check(not errors, "console errors: " + "; ".join(e.get("message", "") for e in errors))

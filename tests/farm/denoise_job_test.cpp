@@ -1,5 +1,5 @@
-// Denoising on the farm (job field denoise): the units carry AOV sums, the raw image (with its AOV
-// layers) is bit for bit render()'s, the denoised image is bit for bit the denoiser's on that raw
+// Denoising on the farm (job field denoise): the units carry AOV sums, a running job's preview can
+// be fetched denoised, the raw image (with its AOV layers) is bit for bit render()'s, the denoised image is bit for bit the denoiser's on that raw
 // image, the job is done only once both are stored, also when the coordinator is stopped and
 // started again while the units arrive and while it denoises.
 #include "coordinator_fixture.h"
@@ -86,6 +86,14 @@ TEST(DenoiseJob, ImagesAreTheLocalRenderAndItsDenoisedImage) {
   EXPECT_EQ(refused.status.code, server::Code::BadRequest);
   EXPECT_NE(refused.status.detail.find("AOV"), std::string::npos) << refused.status.detail;
   ASSERT_TRUE(c.upload_result(worker, l["id"], render_unit(l, *loaded.scene, kSeed)).ok());
+  // While it runs: 202 until a preview of its film is denoised, then that preview.
+  server::Result<server::ImageBytes> preview = c.job_image(id, "pfm", /*denoised=*/true);
+  for (int i = 0; i < 500 && preview.status.code == server::Code::NotYet; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    preview = c.job_image(id, "pfm", /*denoised=*/true);
+  }
+  ASSERT_TRUE(preview.ok()) << preview.status.detail;
+  EXPECT_EQ(pfm_image(preview.value.bytes).width(), 20);
 
   while (deliver_one(c, worker, *loaded.scene, kSeed)) {
   }
