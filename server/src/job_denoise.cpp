@@ -52,7 +52,7 @@ void Coordinator::Impl::complete_job(JobState& job) {
       settings.threads = opt.denoise_threads;
       const Image denoised = denoise(make_denoise_input(*raw, layers), settings);
       seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      write_image_durably(denoised_path(id), denoised, attributes, opt.data_dir);
+      write_image_durably(denoised_path(id), denoised, attributes, opt.data_dir, layers);  // (both carry the AOVs)
     } catch (const std::exception& e) {
       error = std::string(raw_written ? "denoising failed: " : "the raw image was not written: ") + e.what();
     }

@@ -91,10 +91,11 @@ std::optional<std::vector<RetentionJob>> Coordinator::Impl::retention_snapshot()
 
 std::map<std::string, RetentionBundle> Coordinator::Impl::measure_retention_files(std::vector<RetentionJob>& snapshot) {
   std::error_code ec;
-  for (RetentionJob& j : snapshot) {
-    const uintmax_t image = fs::file_size(image_path(j.id), ec);
-    if (!ec) j.bytes += image;
-  }
+  for (RetentionJob& j : snapshot)
+    for (const std::string& path : {image_path(j.id), denoised_path(j.id)}) {  // (a denoised job has both)
+      const uintmax_t image = fs::file_size(path, ec);
+      if (!ec) j.bytes += image;
+    }
   std::map<std::string, RetentionBundle> bundles;
   for (auto it = fs::directory_iterator(fs::path(opt.data_dir) / "bundles", ec); !ec && it != fs::directory_iterator();
        it.increment(ec)) {
@@ -126,7 +127,7 @@ std::optional<RetentionReport> Coordinator::Impl::run_retention(double now) {
 
 RetentionReport Coordinator::Impl::carry_out_retention(const RetentionPlan& plan, const std::vector<RetentionJob>& snapshot,
                                                        const std::map<std::string, RetentionBundle>& bundles, double now) {
-  std::vector<fs::path> trash;  // removed after the lock: images, renamed bundles and scene folders
+  std::vector<fs::path> trash;  // removed after the lock: images (raw, denoised), renamed bundles and scene folders
   std::vector<const RetentionJob*> forgotten;
   std::vector<std::string> moved;
   {
@@ -141,6 +142,7 @@ RetentionReport Coordinator::Impl::carry_out_retention(const RetentionPlan& plan
   RetentionReport report;
   for (const RetentionJob* j : delete_expired_rows(forgotten, moved, now)) {
     trash.push_back(image_path(j->id));
+    trash.push_back(denoised_path(j->id));
     ++report.deleted_jobs;
     report.freed_bytes += j->bytes;
   }

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <filesystem>
 #include <fstream>
 #include <thread>
 
@@ -115,6 +116,31 @@ TEST(DenoiseJob, SurvivesRestartsWhileRenderingAndDenoising) {
   Coordinator c(options(dir));
   ASSERT_EQ(wait_done(c, id).value.state, "done");
   expect_local_images(c, id, *loaded.scene, dir);
+}
+
+// A denoised image that cannot be stored (here: a folder in its place) leaves the job done with its
+// raw image and the reason.
+TEST(DenoiseJob, AFailedDenoiseLeavesTheRawImageAndSaysWhy) {
+  TempDir dir;
+  LoadResult loaded = load_fixture_scene();
+  Coordinator c(options(dir));
+  std::filesystem::create_directories(dir.path / "data" / "images" / "1.denoised.exr" / "in-the-way");
+  const uint64_t worker = add_worker(c, "w");
+  auto job = submit(c, denoised_settings(), bundle());
+  ASSERT_TRUE(job.ok()) << job.status.detail;
+  const uint64_t id = job.value.jobs.at(0).id;
+  ASSERT_EQ(id, 1u);
+  while (deliver_one(c, worker, *loaded.scene, kSeed)) {
+  }
+  const auto status = wait_done(c, id);
+  ASSERT_EQ(status.value.state, "done");
+  EXPECT_EQ(status.value.denoise_state, "failed");
+  EXPECT_EQ(status.value.error, "");
+  EXPECT_NE(status.value.denoise_error.find("denoising failed"), std::string::npos) << status.value.denoise_error;
+  const auto denoised = c.job_image(id, "exr", /*denoised=*/true);
+  EXPECT_EQ(denoised.status.code, server::Code::NotFound);
+  EXPECT_NE(denoised.status.detail.find("denoising failed"), std::string::npos) << denoised.status.detail;
+  EXPECT_EQ(job_exr(c, id, false, dir).color.width(), 20) << "the raw image is kept";
 }
 
 TEST(DenoiseJob, AJobWithoutDenoiseHasNoDenoisedImage) {
