@@ -11,20 +11,6 @@
 
 namespace tessera::cli {
 
-std::vector<ImageLayer> denoise_input_layers(const DenoiseInput& in) {
-  std::vector<ImageLayer> layers;
-  for (AovLayer l : denoise_layers()) {
-    const Image* img = l == AovLayer::Albedo     ? &in.albedo
-                       : l == AovLayer::Normal   ? &in.normal
-                       : l == AovLayer::Depth    ? &in.depth
-                       : l == AovLayer::Variance ? &in.variance
-                       : l == AovLayer::HalfA    ? &in.half_a
-                                                 : &in.half_b;
-    layers.push_back({aov_layer_name(l), aov_channel_names(l), *img});
-  }
-  return layers;
-}
-
 std::string noisy_path(const std::string& path) {
   std::filesystem::path p(path);
   return (p.parent_path() / (p.stem().string() + ".noisy" + p.extension().string())).string();

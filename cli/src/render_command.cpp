@@ -96,7 +96,12 @@ void write_outputs(const RenderOptions& options, const Scene& scene, const Film&
     settings.mode = options.denoise_mode == "preview" ? DenoiseMode::Preview : DenoiseMode::Full;
     settings.threads = options.threads;
     const auto start = Clock::now();
-    denoised = denoise(make_denoise_input(raw, film.aov_layers(denoise_layers())), settings);
+    // (The layers written already hold the denoiser's unless --aovs named fewer.)
+    const std::vector<AovLayer> needed = denoise_layers();
+    const bool written = std::all_of(needed.begin(), needed.end(), [&](AovLayer l) {
+      return std::find(aovs.begin(), aovs.end(), l) != aovs.end();
+    });
+    denoised = denoise(make_denoise_input(raw, written ? layers : film.aov_layers(needed)), settings);
     std::fprintf(stderr, "denoise (%s): %.3f s\n", options.denoise_mode.c_str(), seconds_since(start));
   }
   for (const auto& out : output_paths(options, scene)) {

@@ -64,8 +64,9 @@ bool download(const client::FarmApi& api, uint64_t id, const std::string& out, b
 // `tessera render --denoise` writes them). A failed denoise leaves only the raw one, and fails.
 bool download_outputs(const client::FarmApi& api, uint64_t id, const std::vector<std::string>& outputs,
                       const json& status) {
-  const bool denoised = !status.value("denoise_state", json()).is_null();
-  if (denoised && status.value("denoise_state", json()) != "done")
+  const json state = status.value("denoise_state", json());
+  const bool denoised = !state.is_null();
+  if (denoised && state != "done")
     std::cerr << "tessera submit: job " << id << " was not denoised: " << status.value("denoise_error", json()).dump()
               << "\n";
   bool ok = true;
@@ -75,7 +76,7 @@ bool download_outputs(const client::FarmApi& api, uint64_t id, const std::vector
       continue;
     }
     ok = download(api, id, noisy_path(out), false) && ok;
-    ok = status.value("denoise_state", json()) == "done" && download(api, id, out, true) && ok;
+    ok = state == "done" && download(api, id, out, true) && ok;
   }
   return ok;
 }

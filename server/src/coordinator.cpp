@@ -369,9 +369,10 @@ std::optional<Image> Coordinator::Impl::film_image(uint64_t id, bool consistent,
     height = job->plan().window.height();
   }
   Image image(width, height, 3);  // (allocated off the lock)
+  const std::vector<AovLayer> kinds = layers ? denoise_layers() : std::vector<AovLayer>{};
   if (layers) {
     layers->clear();
-    for (AovLayer l : denoise_layers())
+    for (AovLayer l : kinds)
       layers->push_back({aov_layer_name(l), aov_channel_names(l), Image(width, height, l == AovLayer::Depth ? 1 : 3)});
   }
   const int band = std::max(1, kBandPixels / std::max(1, width));
@@ -388,7 +389,7 @@ std::optional<Image> Coordinator::Impl::film_image(uint64_t id, bool consistent,
     }
     job->image_rows(image, y, std::min(height, y + band));
     for (size_t i = 0; layers && i < layers->size(); ++i)
-      job->aov_rows(denoise_layers()[i], (*layers)[i].image, y, std::min(height, y + band));
+      job->aov_rows(kinds[i], (*layers)[i].image, y, std::min(height, y + band));
     y += band;
   }
   return image;

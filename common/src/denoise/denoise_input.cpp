@@ -21,6 +21,13 @@ Image* slot(DenoiseInput& in, AovLayer layer) {
 
 }  // namespace
 
+std::vector<ImageLayer> denoise_input_layers(const DenoiseInput& in) {
+  std::vector<ImageLayer> layers;
+  for (AovLayer l : denoise_layers())
+    layers.push_back({aov_layer_name(l), aov_channel_names(l), *slot(const_cast<DenoiseInput&>(in), l)});
+  return layers;
+}
+
 DenoiseInput make_denoise_input(const Image& color, const std::vector<ImageLayer>& layers) {
   DenoiseInput in;
   in.color = color.channels() == 3 ? color : color.to_rgb();

@@ -47,6 +47,9 @@ DenoiseInput read_denoise_input(const std::string& path, ImageAttributes* attrib
 /// std::invalid_argument naming a missing layer or a size that differs from the beauty's.
 DenoiseInput make_denoise_input(const Image& color, const std::vector<ImageLayer>& layers);
 
+/// The input's AOV layers, named as written into an EXR (the inverse of make_denoise_input).
+std::vector<ImageLayer> denoise_input_layers(const DenoiseInput& input);
+
 /// The denoised image (3 channels, the input's size); never NaN or Inf.
 Image denoise(const DenoiseInput& input, const DenoiseSettings& settings = {});
 
