@@ -2,7 +2,7 @@
 
 #include "tessera/farm/bundle.h"
 #include "tessera/guiding/tree_io.h"
-#include "tessera/light/light_sampler.h"
+#include "tessera/render/light_sampler.h"
 #include "tessera/render/renderer.h"
 #include "tessera/scene/error.h"
 

@@ -1,4 +1,4 @@
-// Light selection (light/light_sampler.h): the light BVH's choices follow light_pmf (chi-square),
+// Light selection (render/light_sampler.h): the light BVH's choices follow light_pmf (chi-square),
 // light_pmf equals the pmf sample_light returned, the pmfs sum to one (less the probability of
 // choosing nothing), the importance bound never excludes a light that can reach the point, cone
 // merging is conservative; power selection is exactly power / total; meshes are split per triangle.
@@ -7,7 +7,7 @@
 #include "tessera/core/hash.h"
 #include "tessera/light/area.h"
 #include "tessera/light/constant.h"
-#include "tessera/light/light_bounds.h"
+#include "tessera/render/light_bounds.h"
 #include "tessera/light/point.h"
 #include "tessera/render/scene.h"
 #include "tessera/scene/load_context.h"

@@ -4,7 +4,7 @@
 // No chi-square test here: sample_li() of a spot is a delta (one direction, pdf 1), and Tessera has
 // no emission-direction sampler for lights (nothing traces light paths), so there is no sampled
 // density to test; the profile the integrators see is checked value by value instead.
-#include "tessera/light/light_bounds.h"
+#include "tessera/render/light_bounds.h"
 #include "tessera/light/spot.h"
 #include "tessera/scene/load_context.h"
 #include "tessera/scene/scene_desc.h"

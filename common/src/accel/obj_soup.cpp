@@ -1,6 +1,6 @@
 #include "tessera/accel/obj_soup.h"
 
-#include "tessera/scene/error.h"
+#include "tessera/core/error.h"
 
 #include <tbb/parallel_for.h>
 #include <tiny_obj_loader.h>

@@ -1,6 +1,6 @@
 #include "tessera/denoise/denoiser.h"
 
-#include "tessera/scene/error.h"
+#include "tessera/core/error.h"
 
 #include <stdexcept>
 

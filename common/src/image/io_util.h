@@ -1,7 +1,7 @@
 // Helpers shared by the image readers and writers (private to src/image).
 #pragma once
 
-#include "tessera/scene/error.h"
+#include "tessera/core/error.h"
 
 #include <string>
 

@@ -10,7 +10,7 @@
 
 #include "tessera/core/frame.h"
 #include "tessera/core/sampling.h"
-#include "tessera/light/light_bounds.h"
+#include "tessera/render/light_bounds.h"
 #include "tessera/light/triangle_light.h"
 #include "tessera/scene/load_context.h"
 

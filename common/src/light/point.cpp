@@ -2,7 +2,7 @@
 
 #include "light/emitter_sample.h"
 
-#include "tessera/light/light_bounds.h"
+#include "tessera/render/light_bounds.h"
 #include "tessera/scene/load_context.h"
 
 namespace tessera {

@@ -7,7 +7,7 @@
 #include "light/emitter_sample.h"
 
 #include "tessera/core/sampling.h"
-#include "tessera/light/light_bounds.h"
+#include "tessera/render/light_bounds.h"
 
 #include <cmath>
 

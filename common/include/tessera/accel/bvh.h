@@ -20,10 +20,10 @@
 #pragma once
 
 #include "tessera/core/bounds.h"
+#include "tessera/core/hit.h"
 #include "tessera/core/huge_page_allocator.h"
 #include "tessera/core/ray.h"
 #include "tessera/core/vec.h"
-#include "tessera/render/shape.h"
 
 #include <array>
 #include <cstdint>

@@ -20,7 +20,7 @@
 
 namespace tessera {
 
-struct LightBounds;  // light/light_bounds.h
+struct LightBounds;  // render/light_bounds.h
 
 struct LightSample {
   Rgb li;               // incident radiance along -wi arriving at the reference point
@@ -63,7 +63,7 @@ class Light {
   /// Total emitted power (an estimate is fine); lights are picked in proportion to it.
   virtual float power() const = 0;
 
-  /// Light hierarchies: where and in which directions this light emits (light/light_bounds.h).
+  /// Light hierarchies: where and in which directions this light emits (render/light_bounds.h).
   /// False for lights that cannot say (infinite ones); those are picked with a fixed probability.
   virtual bool light_bounds(LightBounds& out) const { return false; }
   /// Area lights on triangle meshes: one light per primitive of the shape, in primitive order, to

@@ -5,7 +5,7 @@
 #include "tessera/accel/bvh.h"
 #include "tessera/core/sampling.h"
 #include "tessera/guiding/spatial_tree.h"
-#include "tessera/light/light_sampler.h"
+#include "tessera/render/light_sampler.h"
 #include "tessera/render/bsdf.h"
 #include "tessera/render/camera.h"
 #include "tessera/render/light.h"
@@ -36,7 +36,7 @@ struct IntegratorSettings {
   // direct integrator only
   int emitter_samples = 1;
   int bsdf_samples = 1;
-  // How next-event estimation picks a light (light/light_sampler.h); read by Scene::finalize.
+  // How next-event estimation picks a light (render/light_sampler.h); read by Scene::finalize.
   LightSelection light_selection = LightSelection::Bvh;
   SamplingStrategy strategy = SamplingStrategy::Mis;  // path/volpath only; not read from scene files
   /// Set by a `guided_path` integrator: the scene asks for path guiding with these settings.

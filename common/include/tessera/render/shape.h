@@ -9,6 +9,7 @@
 #pragma once
 
 #include "tessera/core/bounds.h"
+#include "tessera/core/hit.h"
 #include "tessera/core/ray.h"
 #include "tessera/core/sampling.h"
 #include "tessera/core/vec.h"
@@ -33,14 +34,6 @@ struct MeshData {
   std::vector<Vec2> uvs;       // per vertex; empty when none
   std::vector<uint32_t> indices;  // three per triangle
   size_t num_triangles() const { return indices.size() / 3; }
-};
-
-/// A closest-hit record from the accelerator. For triangles (b1, b2) are the barycentric
-/// coordinates of v1 and v2; spheres leave them unused.
-struct Hit {
-  float t = kInfinity;
-  uint32_t prim = 0xFFFFFFFFu;  // global primitive index (see Scene)
-  float b1 = 0.f, b2 = 0.f;
 };
 
 class Shape {

@@ -3,7 +3,7 @@
 // a factor for thin boxes, over 12 centroid buckets per axis; one light per leaf. Trails are 64
 // bits, so the build balances (median split) whenever an unlucky sequence of cheap splits would
 // otherwise run out of depth.
-#include "tessera/light/light_bvh.h"
+#include "tessera/render/light_bvh.h"
 
 #include "tessera/core/check.h"
 #include "tessera/core/sampling.h"

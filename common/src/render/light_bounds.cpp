@@ -1,7 +1,7 @@
 // Cone arithmetic and the importance bound. Angles are carried as (sin, cos) pairs in the hot
 // importance() so that it needs no trigonometric calls; the merges, done at build time only, use
 // angles.
-#include "tessera/light/light_bounds.h"
+#include "tessera/render/light_bounds.h"
 
 #include "tessera/core/sampling.h"
 

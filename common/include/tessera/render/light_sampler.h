@@ -14,7 +14,7 @@
 #pragma once
 
 #include "tessera/core/alias_table.h"
-#include "tessera/light/light_bvh.h"
+#include "tessera/render/light_bvh.h"
 #include "tessera/render/light.h"
 #include "tessera/render/shape.h"
 

@@ -2,9 +2,9 @@
 // sample() and pmf() compute every probability with the same expressions in the same order, so a
 // light's pmf equals the pmf sample() returned for it bit for bit (MIS relies on the equality, the
 // tests check it).
-#include "tessera/light/light_sampler.h"
+#include "tessera/render/light_sampler.h"
 
-#include "tessera/light/light_bounds.h"
+#include "tessera/render/light_bounds.h"
 
 #include <algorithm>
 

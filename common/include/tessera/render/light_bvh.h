@@ -8,7 +8,7 @@
 // that do not report LightBounds) are the caller's business (LightSampler).
 #pragma once
 
-#include "tessera/light/light_bounds.h"
+#include "tessera/render/light_bounds.h"
 
 #include <cstdint>
 #include <vector>
