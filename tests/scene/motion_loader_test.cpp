@@ -82,8 +82,8 @@ std::string moving(const std::string& close, const std::string& emit = "") {
 TEST(MotionLoader, MovingSphereBecomesAMotionInstance) {
   auto scene = load_scene(parse_scene_string(moving("1"), "mem/m.xml"), LoadOptions{}).scene;
   EXPECT_EQ(scene->shutter_close, 1.f);
-  ASSERT_EQ(scene->motion_instances().size(), 1u);
-  const Bounds3 b = scene->motion_instances()[0].world_bounds;
+  ASSERT_EQ(scene->instance_accel().size(), 1u);
+  const Bounds3 b = scene->placement_bounds(0);
   EXPECT_LE(b.lo.x, -1.f);
   EXPECT_GE(b.hi.x, 3.f);
   EXPECT_TRUE(scene->bounds().contains(Vec3(3.f, 0.f, 5.f)));

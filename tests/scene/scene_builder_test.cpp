@@ -221,13 +221,31 @@ TEST(SceneBuilder, InstancesComposeTransforms) {
 <shape type="instance"><ref id="g"/><transform name="to_world"><translate x="10"/></transform></shape>
 <shape type="instance"><ref id="g"/><transform name="to_world"><scale value="2"/><translate x="-10"/></transform></shape>)";
   LoadResult r = load(body);
-  ASSERT_EQ(r.scene->shapes.size(), 4u);
-  const auto& s0 = static_cast<const SphereShape&>(*r.scene->shapes[0]);
-  EXPECT_NEAR(s0.center().x, 10.f, 1e-6f);
-  const auto& s1 = static_cast<const SphereShape&>(*r.scene->shapes[2]);
-  EXPECT_NEAR(s1.center().x, -10.f, 1e-6f);
-  EXPECT_NEAR(s1.radius(), 0.5f, 1e-6f);
-  for (Vec3 p : mesh_shape(*r.scene, 3).mesh().positions) EXPECT_FLOAT_EQ(p.z, 2.f);  // translate, then scale 2
+  // The group's members are built once, in the group's space; each instance places them.
+  ASSERT_EQ(r.scene->shapes.size(), 2u);
+  for (const auto& s : r.scene->shapes) EXPECT_EQ(s->group, 0u);
+  const auto& sphere = static_cast<const SphereShape&>(*r.scene->shapes[0]);
+  EXPECT_EQ(sphere.center(), Vec3(0.f));
+  for (Vec3 p : mesh_shape(*r.scene, 1).mesh().positions) EXPECT_FLOAT_EQ(p.z, 1.f);
+  ASSERT_EQ(r.scene->instances.size(), 2u);
+  EXPECT_EQ(r.scene->instances[1].group, 0u);
+  // Translate, then scale 2: the rectangle at z = 2, the sphere of radius 0.5 at x = -10.
+  const Transform xf = r.scene->instances[1].world_from_object.at(0.f);
+  EXPECT_NEAR(xf.apply_point(Vec3(0.f, 0.f, 1.f)).z, 2.f, 1e-6f);
+  EXPECT_NEAR(xf.apply_point(Vec3(0.f)).x, -10.f, 1e-6f);
+  Ray ray;
+  ray.o = Vec3(-10.f, 0.f, -5.f);
+  ray.d = Vec3(0.f, 0.f, 1.f);
+  SurfaceInteraction si;
+  ASSERT_TRUE(r.scene->intersect(ray, si));
+  EXPECT_NEAR(si.t, 4.5f, 1e-5f);
+  EXPECT_EQ(si.shape, r.scene->shapes[0].get());
+  EXPECT_NEAR(si.ng.z, -1.f, 1e-5f);
+  ray.o = Vec3(10.2f, 0.3f, -5.f);
+  ASSERT_TRUE(r.scene->intersect(ray, si));
+  EXPECT_NEAR(si.t, 6.f, 1e-5f);  // the rectangle at z = 1, past the sphere of radius 0.25
+  EXPECT_NEAR(si.p.x, 10.2f, 1e-5f);
+  EXPECT_EQ(r.scene->num_instanced_triangles(), 4u);
   EXPECT_TRUE(r.unsupported.empty());
 }
 
@@ -394,7 +412,8 @@ TEST(SceneBuilder, UnsupportedSensorFilterIntegratorAndInstancedEmitter) {
   EXPECT_EQ(r.scene->film.filter->name(), "gaussian");
   EXPECT_EQ(r.scene->sampler.type, SamplerType::Independent);
   EXPECT_EQ(r.scene->sampler.sample_count, 9);
-  EXPECT_EQ(r.scene->shapes.size(), 2u);
+  EXPECT_EQ(r.scene->shapes.size(), 1u);  // the group's sphere, once
+  EXPECT_EQ(r.scene->instances.size(), 2u);
   EXPECT_TRUE(r.scene->lights.empty());
   EXPECT_NE(r.scene->camera, nullptr);
 }

@@ -24,6 +24,17 @@ struct BinaryNode {
 /// spheres). Parallel in the caller's task arena; the result does not depend on the thread count.
 HugeVector<BinaryNode> build_binary(HugeVector<PrimRef>& refs, uint32_t block);
 
+/// Leaves of a binary tree in depth-first (array) order, with the first packet (or sphere) each
+/// one gets when leaves take ceil(count / block) consecutive slots.
+struct LeafSlots {
+  std::vector<uint32_t> leaves;      // binary node indices
+  std::vector<uint32_t> first_slot;  // per entry of `leaves`
+  std::vector<uint32_t> refs;        // per binary node: the leaf's bvh_ref (leaves only)
+  uint32_t total = 0;
+};
+
+LeafSlots assign_slots(const HugeVector<BinaryNode>& binary, uint32_t block);
+
 /// The wide tree of a binary one: each wide node takes a binary node's children and repeatedly
 /// opens the interior child of largest surface area until it has kBvhWidth (or only leaves remain).
 /// `leaf_refs[i]` is the bvh_ref of binary leaf i (indexed like `binary`). Depth-first, first

@@ -11,24 +11,8 @@
 #include <limits>
 
 namespace tessera {
-using namespace accel_detail;
 
-namespace {
-
-bool valid_triangle(const std::array<Vec3, 3>& t) {
-  if (!is_finite(t[0]) || !is_finite(t[1]) || !is_finite(t[2])) return false;
-  const Vec3 n = cross(t[1] - t[0], t[2] - t[0]);
-  return n.x != 0.f || n.y != 0.f || n.z != 0.f;
-}
-
-/// Leaves of a binary tree in depth-first (array) order, with the first packet (or sphere) each
-/// one gets when leaves take ceil(count / block) consecutive slots.
-struct LeafSlots {
-  std::vector<uint32_t> leaves;      // binary node indices
-  std::vector<uint32_t> first_slot;  // per entry of `leaves`
-  std::vector<uint32_t> refs;        // per binary node: the leaf's bvh_ref (leaves only)
-  uint32_t total = 0;
-};
+namespace accel_detail {
 
 LeafSlots assign_slots(const HugeVector<BinaryNode>& binary, uint32_t block) {
   LeafSlots s;
@@ -45,6 +29,18 @@ LeafSlots assign_slots(const HugeVector<BinaryNode>& binary, uint32_t block) {
   }
   s.total = uint32_t(next);
   return s;
+}
+
+}  // namespace accel_detail
+
+using namespace accel_detail;
+
+namespace {
+
+bool valid_triangle(const std::array<Vec3, 3>& t) {
+  if (!is_finite(t[0]) || !is_finite(t[1]) || !is_finite(t[2])) return false;
+  const Vec3 n = cross(t[1] - t[0], t[2] - t[0]);
+  return n.x != 0.f || n.y != 0.f || n.z != 0.f;
 }
 
 /// References of the valid triangles, in input order; made in parallel over fixed chunks (count,

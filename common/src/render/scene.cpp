@@ -14,7 +14,7 @@ void Scene::finalize() {
   std::vector<SpherePrim> spheres;
   size_t tri_count = 0, sphere_count = 0;
   for (const auto& s : shapes) {
-    if (s->motion) continue;  // moving shapes: build_motion()
+    if (s->is_placed()) continue;  // build_instances()
     if (s->kind() == Shape::Kind::Mesh) tri_count += s->num_primitives();
     else sphere_count += 1;
   }
@@ -28,7 +28,7 @@ void Scene::finalize() {
   uint32_t next_tri = 0, next_sphere = uint32_t(tri_count);
   for (uint32_t si = 0; si < shapes.size(); ++si) {
     const Shape& s = *shapes[si];
-    if (s.motion) continue;
+    if (s.is_placed()) continue;
     if (s.kind() == Shape::Kind::Mesh) {
       const auto& mesh = static_cast<const TriangleMeshShape&>(s).mesh();
       shape_first_[si] = next_tri;
@@ -51,8 +51,8 @@ void Scene::finalize() {
                            [](const auto& s) { return s->bsdf && s->bsdf->has_opacity(); });
   auto t0 = std::chrono::steady_clock::now();
   accel_ = Bvh::build(std::move(triangles), std::move(spheres));
+  build_instances();
   bvh_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  build_motion(uint32_t(tri_count + sphere_count));
 
   Bounds3 b = bounds();
   if (b.empty()) b.extend(Vec3(0.f));
@@ -66,8 +66,8 @@ void Scene::finalize() {
 }
 
 void Scene::fill(const Ray& ray, const Hit& hit, SurfaceInteraction& si) const {
+  if (hit.inst != Hit::kNoInstance) return fill_placed(ray, hit, si);
   TESSERA_DCHECK(hit.prim < prim_shape_.size());
-  if (hit.prim >= num_static_prims_) return fill_moving(ray, hit, si);
   uint32_t shape_index = prim_shape_[hit.prim];
   const Shape* shape = shapes[shape_index].get();
   shape->fill_interaction(ray, hit, hit.prim - shape_first_[shape_index], si);

@@ -1,5 +1,6 @@
-// Description -> Scene: shapes (to world space, with BSDF and area light), instances of shape
-// groups, stand-alone emitters; then the sensor, the report of what was not consumed, finalize().
+// Description -> Scene: shapes (to world space, with BSDF and area light), shapegroups (their
+// members once, in the group's object space) and their instances (render/instance.h), stand-alone
+// emitters; then the sensor, the report of what was not consumed, finalize().
 //
 // Orientation under mirroring transforms follows Mitsuba: a mesh's geometric normal comes from its
 // world-space winding (so a mirrored mesh turns inside out, as in Mitsuba), while the analytic
@@ -80,8 +81,8 @@ class ShapeBuilder {
  public:
   explicit ShapeBuilder(BuildState& st) : st_(st) {}
 
-  /// `parent` is the instance transform for shapes inside a shapegroup (identity otherwise).
-  void build(const std::shared_ptr<SceneNode>& node_ptr, const AnimatedTransform& parent, bool in_group) {
+  /// `group`: the shapegroup the shape is a member of (Shape::kNoGroup for a world-space shape).
+  void build(const std::shared_ptr<SceneNode>& node_ptr, uint32_t group) {
     const SceneNode& node = *node_ptr;
     if (node.type == "instance") {
       build_instance(node);
@@ -94,10 +95,16 @@ class ShapeBuilder {
     if (cached == geometry_.end()) cached = geometry_.emplace(&node, make_geometry(node, factory)).first;
     const ShapeGeometry& g = cached->second;
 
-    // Motion blur (docs/scene-support.md): an <animation> to_world, an animated instance, or a
-    // sphere's center_close make the shape move over the shutter; it then keeps object-space
-    // geometry and `motion`. Without a shutter interval everything is placed at shutter_open.
-    AnimatedTransform anim = placement(node, parent, g);
+    // Motion blur (docs/scene-support.md): an <animation> to_world or a sphere's center_close make
+    // the shape move over the shutter; it then keeps object-space geometry and `motion`. Without a
+    // shutter interval everything is placed at shutter_open. A shapegroup's members are shared by
+    // all its instances, so they cannot move on their own (an instance can).
+    AnimatedTransform anim = placement(node, g);
+    if (group != Shape::kNoGroup && !anim.is_static() && st_.scene.has_shutter_interval()) {
+      st_.ctx.unsupported(node.loc_of("to_world"), "a moving " + node.describe() + " inside a shapegroup",
+                          "its placement at shutter_open (animate the instance instead)");
+      anim = AnimatedTransform(anim.at(st_.scene.shutter_open));
+    }
     const bool moving = !anim.is_static() && st_.scene.has_shutter_interval();
     const Transform xf = anim.is_static() || !moving ? anim.at(st_.scene.shutter_open) : Transform();
     auto bsdfs = node.children_with_tag("bsdf");
@@ -138,7 +145,8 @@ class ShapeBuilder {
     const Property* file = node.peek("filename");
     if (file && file->type == PropType::String) shape->name += " (" + file->s + ")";
     if (moving) shape->motion = std::make_shared<const AnimatedTransform>(std::move(anim));
-    attach_emitter(node, *shape, in_group, moving);
+    shape->group = group;
+    attach_emitter(node, *shape, group != Shape::kNoGroup, moving);
     st_.scene.shapes.push_back(std::move(shape));
   }
 
@@ -158,24 +166,14 @@ class ShapeBuilder {
 
  private:
   BuildState& st_;
-  std::map<const SceneNode*, ShapeGeometry> geometry_;  // a shapegroup member is loaded once
+  std::map<const SceneNode*, ShapeGeometry> geometry_;  // a mesh file is loaded once
+  std::map<const SceneNode*, uint32_t> groups_;         // shapegroup -> its index (Shape::group)
 
-  /// world_from_object over time: parent (instance) * to_world * (sphere) centre motion.
-  AnimatedTransform placement(const SceneNode& node, const AnimatedTransform& parent, const ShapeGeometry& g) {
-    const AnimatedTransform own = node.get_animated_transform("to_world", Transform());
+  /// world_from_object over time (a group member's: group_from_object): to_world * (sphere) centre motion.
+  AnimatedTransform placement(const SceneNode& node, const ShapeGeometry& g) {
     const float t0 = st_.scene.shutter_open, t1 = st_.scene.shutter_close;
-    AnimatedTransform anim;
-    if (parent.is_static() && own.is_static()) {
-      anim = AnimatedTransform(parent.at(t0) * own.at(t0));  // exactly the static product
-    } else if (parent.is_static()) {
-      anim = own.composed(parent.at(t0), Transform());
-    } else if (own.is_static()) {
-      anim = parent.composed(Transform(), own.at(t0));
-    } else {
-      st_.ctx.unsupported(node.loc_of("to_world"), "an animated " + node.describe() + " inside an animated instance",
-                          "the shape's to_world at shutter_open");
-      anim = parent.composed(Transform(), own.at(t0));
-    }
+    AnimatedTransform anim = node.get_animated_transform("to_world", Transform());
+    if (anim.is_static()) anim = AnimatedTransform(anim.at(t0));
     // Tessera extension: a sphere's centre at shutter close (docs/plugins.md), linear in between.
     const Property* cc = g.is_sphere ? node.find("center_close") : nullptr;
     if (!cc) return anim;
@@ -228,13 +226,18 @@ class ShapeBuilder {
       }
     if (!group) throw SceneError(node.loc, "an instance needs a <ref> to a shapegroup");
     group->used = true;
-    const AnimatedTransform xf = node.get_animated_transform("to_world", Transform());
-    for (const auto& child : group->children) {
-      if (child->tag != "shape") continue;  // anything else is reported by the final walk
-      if (child->type == "shapegroup" || child->type == "instance")
-        throw SceneError(child->loc, "shapegroups cannot contain " + child->type + "s");
-      build(child, xf, true);
+    const auto [it, first_use] = groups_.emplace(group.get(), uint32_t(groups_.size()));
+    if (first_use) {
+      for (const auto& child : group->children) {
+        if (child->tag != "shape") continue;  // anything else is reported by the final walk
+        if (child->type == "shapegroup" || child->type == "instance")
+          throw SceneError(child->loc, "shapegroups cannot contain " + child->type + "s");
+        build(child, it->second);
+      }
     }
+    AnimatedTransform xf = node.get_animated_transform("to_world", Transform());
+    if (xf.is_static() || !st_.scene.has_shutter_interval()) xf = AnimatedTransform(xf.at(st_.scene.shutter_open));
+    st_.scene.instances.push_back({it->second, std::move(xf)});
   }
 };
 
@@ -243,7 +246,7 @@ class ShapeBuilder {
 void build_shapes(BuildState& st) {
   ShapeBuilder builder(st);
   for (const auto& c : st.desc.root->children)
-    if (c->tag == "shape" && c->type != "shapegroup") builder.build(c, AnimatedTransform(), false);
+    if (c->tag == "shape" && c->type != "shapegroup") builder.build(c, Shape::kNoGroup);
 }
 
 void build_emitters(BuildState& st) {

@@ -193,7 +193,18 @@ float horizontal_fov(const SceneNode& sensor, double aspect) {
 /// Mitsuba 3's camera for a scene without a sensor: 45 degrees, looking along +z at the bounds.
 void default_camera(BuildState& st) {
   Bounds3 b;
-  for (const auto& s : st.scene.shapes) b.extend(s->bounds());
+  std::vector<Bounds3> groups;
+  for (const auto& s : st.scene.shapes) {
+    if (s->group == Shape::kNoGroup) {
+      b.extend(s->bounds());
+      continue;
+    }
+    if (groups.size() <= s->group) groups.resize(s->group + 1);
+    groups[s->group].extend(s->bounds());
+  }
+  for (const ShapeInstance& in : st.scene.instances)
+    if (in.group < groups.size() && !groups[in.group].empty())
+      b.extend(in.world_from_object.at(st.scene.shutter_open).apply(groups[in.group]));
   Transform xf;
   float near_clip = 1e-2f, far_clip = 1e4f;
   if (!b.empty() && is_finite(b.lo) && is_finite(b.hi)) {

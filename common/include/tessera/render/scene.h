@@ -1,8 +1,10 @@
-// A loaded scene: world-space shapes, materials, lights, camera and settings, plus the accelerator.
+// A loaded scene: shapes (world space, or object space placed by instances), materials, lights,
+// camera and settings, plus the accelerators.
 // Immutable after load(); shared read-only by all render threads.
 #pragma once
 
 #include "tessera/accel/bvh.h"
+#include "tessera/accel/instance_bvh.h"
 #include "tessera/core/sampling.h"
 #include "tessera/guiding/spatial_tree.h"
 #include "tessera/render/light_sampler.h"
@@ -10,7 +12,7 @@
 #include "tessera/render/camera.h"
 #include "tessera/render/light.h"
 #include "tessera/render/medium.h"
-#include "tessera/render/motion.h"
+#include "tessera/render/instance.h"
 #include "tessera/render/shape.h"
 #include "tessera/render/texture.h"
 
@@ -54,6 +56,8 @@ class Scene {
  public:
   // Everything is owned here; objects refer to each other by raw pointer.
   std::vector<std::unique_ptr<Shape>> shapes;
+  // Placements of shapegroups (render/instance.h); groups are numbered 0.. by Shape::group.
+  std::vector<ShapeInstance> instances;
   std::vector<std::shared_ptr<Bsdf>> bsdfs;
   std::vector<std::shared_ptr<Texture>> textures;
   std::vector<std::unique_ptr<Light>> lights;
@@ -64,7 +68,7 @@ class Scene {
   SamplerSettings sampler;
   IntegratorSettings integrator;
   // Motion blur: camera rays get a time in [shutter_open, shutter_close] (equal: no blur, all
-  // rays at shutter_open). Shapes with `Shape::motion` move over it (render/motion.h).
+  // rays at shutter_open). Shapes with `Shape::motion` move over it (render/instance.h).
   float shutter_open = 0.f, shutter_close = 0.f;
   bool has_shutter_interval() const { return shutter_close > shutter_open; }
 
@@ -80,7 +84,7 @@ class Scene {
   bool intersect(const Ray& ray, SurfaceInteraction& si, bool stop_at_null = false) const;
   /// Any hit, ignoring opacity: for callers that want geometry only (opaque scenes: the same as a
   /// shadow ray's visibility).
-  bool occluded(const Ray& ray) const { return accel_.occluded(ray) || (!motion_.empty() && motion_occluded(ray)); }
+  bool occluded(const Ray& ray) const { return accel_.occluded(ray) || (!top_.empty() && top_.occluded(ray)); }
   /// Fraction of light that gets along a shadow-ray segment: 0 when an opaque surface blocks it,
   /// otherwise the product of (1 - opacity) over the masked surfaces crossed.
   float transmittance(const Ray& ray) const;
@@ -91,9 +95,12 @@ class Scene {
   bool has_media() const { return has_media_; }
   /// True when some shape's BSDF has opacity (else intersect/transmittance take the fast path).
   bool has_masks() const { return has_masks_; }
-  /// True when some shape moves (Shape::motion); else rays never look at motion instances.
-  bool has_motion() const { return !motion_.empty(); }
-  const std::vector<MotionInstance>& motion_instances() const { return motion_; }
+  /// True when some shape moves (Shape::motion) or some instance does.
+  bool has_motion() const { return has_motion_; }
+  /// Everything placed by a transform: the instances, then one per moving shape (render/instance.h).
+  const InstanceBvh& instance_accel() const { return top_; }
+  /// World bounds of placement `i` of instance_accel() (over the shutter when it moves).
+  const Bounds3& placement_bounds(uint32_t i) const { return placements_[i].world_bounds; }
 
   /// Picks a light to sample from the shading point `ctx` (by power, or by the light hierarchy from
   /// the point and normal: integrator.light_selection). Null (pmf 0) when the scene has none or
@@ -111,36 +118,54 @@ class Scene {
   const std::vector<const Light*>& infinite_lights() const { return infinite_lights_; }
 
   const Bvh& accel() const { return accel_; }
-  Bounds3 bounds() const { return motion_.empty() ? accel_.bounds() : merge(accel_.bounds(), motion_bounds_); }
+  Bounds3 bounds() const { return merge(accel_.bounds(), top_.bounds()); }
+  /// Triangles stored: world-space ones plus each group's and moving shape's once.
   size_t num_triangles() const { return num_triangles_; }
+  /// Triangles as the camera sees them: every instance counts its group's triangles.
+  uint64_t num_instanced_triangles() const { return num_instanced_triangles_; }
+  /// Bytes of the BVHs: world, groups, moving shapes and the top level over instances.
+  size_t accel_bytes() const;
   double bvh_build_seconds() const { return bvh_seconds_; }
 
  private:
   Bvh accel_;
-  std::vector<uint32_t> prim_shape_;   // global primitive -> shape index
-  std::vector<uint32_t> shape_first_;  // shape index -> first global primitive
+  std::vector<uint32_t> prim_shape_;   // world BVH primitive -> shape index
+  std::vector<uint32_t> shape_first_;  // shape index -> first primitive in its BVH (world or group)
   LightSampler light_sampler_;
   std::vector<const Light*> infinite_lights_;
   size_t num_triangles_ = 0;
   double bvh_seconds_ = 0;
   bool has_masks_ = false;
   bool has_media_ = false;
-  // Moving shapes (scene_motion.cpp); their primitives are numbered from num_static_prims_ on.
-  std::vector<MotionInstance> motion_;
-  std::vector<uint32_t> shape_motion_;  // shape index -> motion instance (only for moving shapes)
-  Bounds3 motion_bounds_;
-  uint32_t num_static_prims_ = 0;
+  // Placed geometry (scene_instances.cpp): one BVH per group (moving shapes: a group each), the
+  // placements and the top level over them.
+  struct GroupAccel {
+    Bvh bvh;
+    std::vector<uint32_t> prim_shape;  // group primitive -> shape index
+  };
+  struct Placement {
+    uint32_t group = 0;
+    Transform world_from_object;                // static placements
+    const AnimatedTransform* motion = nullptr;  // moving ones (owned by the instance or the shape)
+    Bounds3 world_bounds;
+  };
+  std::vector<GroupAccel> groups_;
+  std::vector<Placement> placements_;
+  InstanceBvh top_;
+  uint64_t num_instanced_triangles_ = 0;
+  bool has_motion_ = false;
 
   void fill(const Ray& ray, const Hit& hit, SurfaceInteraction& si) const;
-  /// Closest hit of the static BVH and, when the scene has them, of the moving shapes.
+  /// Closest hit of the world BVH and, when the scene has them, of the placed shapes.
   bool closest_hit(const Ray& ray, Hit& hit) const {
-    const bool found = accel_.intersect(ray, hit);
-    return motion_.empty() ? found : motion_intersect(ray, hit, found);
+    bool found = accel_.intersect(ray, hit);
+    if (top_.empty()) return found;
+    Ray r = ray;
+    if (found) r.tmax = hit.t;
+    return top_.intersect(r, hit) || found;
   }
-  void build_motion(uint32_t first_prim);
-  bool motion_intersect(const Ray& ray, Hit& hit, bool found) const;
-  bool motion_occluded(const Ray& ray) const;
-  void fill_moving(const Ray& ray, const Hit& hit, SurfaceInteraction& si) const;
+  void build_instances();
+  void fill_placed(const Ray& ray, const Hit& hit, SurfaceInteraction& si) const;
 };
 
 /// The medium a ray leaving the hit `si` in direction `w` travels in, given the one it arrived in:

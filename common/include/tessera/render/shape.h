@@ -1,8 +1,9 @@
 // Shapes: world-space geometry the accelerator intersects, with what the integrator needs at a hit.
 //
 // Two kinds reach the accelerator: triangle meshes (all of obj/ply/serialized/rectangle/cube/disk
-// end up as these) and analytic spheres. Both are stored in WORLD space: transforms are applied once
-// at load time, so the hot path never transforms rays.
+// end up as these) and analytic spheres. Both are stored in WORLD space (transforms applied once at
+// load time, so most rays are never transformed), except members of shapegroups and moving shapes,
+// which keep object space and are placed by instances (render/instance.h).
 // Orientation: the geometric normal of a triangle (v0,v1,v2) is normalize(cross(v1-v0, v2-v0)),
 // negated when `flip_normals` is set; a sphere's faces outward (inward when flipped).
 // Area sampling returns a density with respect to AREA on the shape.
@@ -62,8 +63,14 @@ class Shape {
   const Medium* exterior = nullptr;
   bool medium_interface = false;  // the scene gave this shape an interior or exterior medium
   // Set for a moving shape (motion blur): its geometry is then in OBJECT space and this places it
-  // in the world at each time (render/motion.h). Null: world-space geometry, as everywhere else.
+  // in the world at each time (render/instance.h). Null: world-space geometry, as everywhere else.
   std::shared_ptr<const AnimatedTransform> motion;
+  // Set for a member of a shapegroup: its geometry is in the group's OBJECT space and the scene's
+  // instances of the group place it (render/instance.h).
+  static constexpr uint32_t kNoGroup = 0xFFFFFFFFu;
+  uint32_t group = kNoGroup;
+  /// True when the geometry is in object space (a group member or a moving shape).
+  bool is_placed() const { return motion != nullptr || group != kNoGroup; }
   std::string name;              // for messages: "shape 'obj' (models/Mesh001.obj)"
 };
 
