@@ -7,6 +7,7 @@
 #include "tessera/render/shape.h"
 #include "tessera/scene/load_context.h"
 #include "tessera/scene/scene_desc.h"
+#include "tessera/texture/bitmap.h"
 
 #include <tbb/info.h>
 
@@ -199,16 +200,19 @@ int run_render(const RenderOptions& options) {
     const auto& c = stats.counters;
     BvhStats bvh = scene.accel().stats();
     const size_t meshes = mesh_bytes(scene);
+    const TextureMemory textures = texture_memory(scene.textures);
     std::fprintf(stderr,
                  "scene %s: %zu triangles, %zu shapes, %zu lights (%zu selectable, %s selection); BVH %zu nodes, %.1f MB\n"
-                 "memory: BVH %.1f bytes/triangle, meshes %.1f MB (%.1f bytes/triangle)\n"
+                 "memory: BVH %.1f bytes/triangle, meshes %.1f MB (%.1f bytes/triangle), textures %.1f MB in %zu "
+                 "images (%.1f MB as float)\n"
                  "times: parse %.3f s, load %.3f s (BVH build %.3f s), render %.3f s\n"
                  "render: %dx%d, %d spp, %d threads: %.3g samples/s, %.3g rays/s",
                  options.scene.c_str(), scene.num_triangles(), scene.shapes.size(), scene.lights.size(),
                  scene.light_sampler().lights().size(), light_selection_name(scene.light_sampler().strategy()),
                  bvh.nodes, double(bvh.bytes) / 1e6,
                  double(bvh.bytes) / double(std::max<size_t>(scene.num_triangles(), 1)), double(meshes) / 1e6,
-                 double(meshes) / double(std::max<size_t>(scene.num_triangles(), 1)), parse_s, load_s - scene.bvh_build_seconds(),
+                 double(meshes) / double(std::max<size_t>(scene.num_triangles(), 1)), double(textures.bytes) / 1e6,
+                 textures.images, double(textures.float_bytes) / 1e6, parse_s, load_s - scene.bvh_build_seconds(),
                  scene.bvh_build_seconds(), stats.seconds, film.width(), film.height(), settings.spp,
                  settings.threads, double(c.samples) / std::max(stats.seconds, 1e-9),
                  double(c.rays()) / std::max(stats.seconds, 1e-9));

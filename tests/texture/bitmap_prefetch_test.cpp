@@ -1,7 +1,8 @@
-// Decoding a scene's bitmaps ahead of the build, in parallel: every file is decoded at the first
-// bitmap, the files a scene is said to need are unchanged, and the loaded texels are the same
-// bytes whatever the number of threads.
+// Decoding a scene's bitmaps ahead of the build, in the background: every file is decoded once,
+// the files a scene is said to need are unchanged, and the loaded texels are the same bytes
+// whatever the number of threads.
 #include "tessera/texture/bitmap.h"
+#include "tessera/texture/bitmap_prefetch.h"
 
 #include "texture/test_image_files.h"
 #include "texture/texture_test_util.h"
@@ -55,19 +56,44 @@ std::string scene_body(const std::vector<std::string>& p) {
   return body;
 }
 
-TEST(BitmapPrefetch, FirstBitmapDecodesEveryFileOfTheScene) {
+TEST(BitmapPrefetch, TheLoadStartsDecodingEveryFileOfTheScene) {
   TextureTempDir dir;
   const auto paths = write_files(dir);
-  TextureScene s(scene_body(paths) + bsdf("missing", paths[4]));
-  s.texture("a");
-  // a.png (twice, one decoding), b.exr with gamma, c.png, d.exr's alpha: four decoded at once.
-  EXPECT_EQ(s.ctx.num_cached_resources(), 4u);
+  // Two bsdfs no shape uses: one names a missing file, one a decoding nothing else needs.
+  TextureScene s(scene_body(paths) + bsdf("missing", paths[4]) +
+                 bsdf("unused", paths[1], "<boolean name=\"raw\" value=\"true\"/>"));
+  const BitmapPrefetch* ahead = bitmap_prefetch(s.ctx);
+  ASSERT_NE(ahead, nullptr);
+  // a.png (twice, one decoding), b.exr with gamma, c.png, d.exr's alpha: four, all decoded;
+  // nothing for the unused bsdfs.
+  EXPECT_EQ(ahead->wait_all(), 4u);
+  EXPECT_EQ(ahead->get(bitmap_cache_key(paths[1], BitmapDecodeSettings{0.f, true, -1})), nullptr);
   // Looking ahead does not count a file as used before the build uses it.
+  EXPECT_TRUE(s.ctx.resolved_files().empty());
+  // The build takes the decoded texels rather than decoding again.
+  const auto& a = dynamic_cast<const BitmapTexture&>(*s.texture("a"));
+  const std::string key = bitmap_cache_key(paths[0], BitmapDecodeSettings{});
+  EXPECT_EQ(a.texels().get(), &ahead->get(key)->texels);
   ASSERT_EQ(s.ctx.resolved_files().size(), 1u);
   EXPECT_EQ(s.ctx.resolved_files()[0], paths[0]);
   // The missing file is still reported where the scene names it.
   const std::string msg = test::scene_error_of([&] { s.texture("missing"); });
   EXPECT_NE(msg.find("e.jpg"), std::string::npos) << msg;
+}
+
+TEST(BitmapPrefetch, TheBuildDecodesWhatNoTaskHasStartedYet) {
+  // A one-thread arena whose only thread is busy with the build, so no task can start: the
+  // factory must decode the file it needs itself (waiting for a task would never return).
+  TextureTempDir dir;
+  const auto paths = write_files(dir);
+  tbb::task_arena arena(1);
+  arena.execute([&] {
+    TextureScene s(scene_body(paths));
+    const auto& a = dynamic_cast<const BitmapTexture&>(*s.texture("c"));
+    const Image got = a.texels()->to_image();
+    const Image want = decode_bitmap_file(paths[2], BitmapDecodeSettings{}).texels.to_image();
+    EXPECT_TRUE(got.values() == want.values());
+  });
 }
 
 LoadResult load_in_arena(int threads, const SceneDesc& desc) {

@@ -252,7 +252,7 @@ TEST(BitmapTexture, EachFileIsDecodedOncePerScene) {
   EXPECT_EQ(as_bitmap(a).texels(), as_bitmap(b).texels());  // ...one decoded image
   auto c = s.texture("c");  // other decoding: another image
   EXPECT_NE(as_bitmap(c).texels(), as_bitmap(a).texels());
-  EXPECT_EQ(s.ctx.num_cached_resources(), 2u);
+  EXPECT_EQ(s.ctx.num_resources<DecodedBitmap>(), 2u);
 }
 
 TEST(BitmapTexture, RealSceneTextureLoadsAsSrgb) {

@@ -16,7 +16,9 @@ namespace tessera {
 namespace fs = std::filesystem;
 
 LoadContext::LoadContext(const SceneDesc& desc, const LoadOptions& options, Scene& scene)
-    : desc_(desc), options_(options), scene_(scene) {}
+    : desc_(desc), options_(options), scene_(scene) {
+  for (LookaheadPass pass : lookahead_passes()) pass(*this);
+}
 
 std::string LoadContext::resolve_path(const std::string& name, const FileLoc& loc) const {
   std::string path = locate_file(name, loc);

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <set>
 
 namespace tessera {
 
@@ -133,6 +134,19 @@ Vec2 BitmapTexture::eval_1_gradient(const SurfaceInteraction& si) const {
   return to_uv_.pull_back(texels_->visit([&](auto format) { return lookup_gradient_1<decltype(format)::value>(uv); }));
 }
 
+TextureMemory texture_memory(const std::vector<std::shared_ptr<Texture>>& textures) {
+  TextureMemory m;
+  std::set<const TexelStorage*> seen;
+  for (const auto& t : textures) {
+    const auto* b = dynamic_cast<const BitmapTexture*>(t.get());
+    if (!b || !seen.insert(b->texels().get()).second) continue;
+    m.bytes += b->texels()->bytes();
+    m.float_bytes += b->texels()->float_bytes();
+    ++m.images;
+  }
+  return m;
+}
+
 namespace {
 
 WrapMode read_wrap_mode(const SceneNode& node, const std::string& name, const std::string& def) {
@@ -197,10 +211,13 @@ std::shared_ptr<Texture> make_bitmap(const SceneNode& node, LoadContext& ctx) {
   if (channel_index == -2)
     throw SceneError(node.find("channel")->loc, node.describe() + ": unknown channel '" + channel + "' (r, g, b, a)");
 
-  // Every bitmap of the scene is decoded at the first one, in parallel; this one is then cached.
-  if (ctx.first_time("bitmap prefetch")) prefetch_bitmaps(ctx);
   const BitmapDecodeSettings settings{gamma, raw, channel_index};
   const std::string key = bitmap_cache_key(path, settings);
+  // Decoded in the background since the load began (bitmap_prefetch.h), unless the look-ahead
+  // missed this one or could not read it: then here, where an error can name the scene's line.
+  if (!ctx.has_resource<DecodedBitmap>(key))
+    if (const BitmapPrefetch* ahead = bitmap_prefetch(ctx))
+      if (auto d = ahead->get(key)) ctx.add_resource(key, std::move(d));
   std::shared_ptr<const DecodedBitmap> decoded = ctx.cached_resource<DecodedBitmap>(key, [&] {
     try {
       return decode_bitmap_file(path, settings);

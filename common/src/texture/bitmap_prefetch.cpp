@@ -1,10 +1,8 @@
 // Decoding a scene's bitmaps ahead of the build: collect (file, decoding) pairs from the parsed
-// description, decode the distinct ones on all cores, hand them to the load's cache.
+// description and decode the distinct ones in TBB tasks while the build goes on.
 #include "tessera/texture/bitmap_prefetch.h"
 
 #include "tessera/texture/bitmap_decode.h"
-
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cctype>
@@ -18,11 +16,8 @@ namespace tessera {
 
 namespace {
 
-struct DecodeJob {
-  std::string key, path;
-  BitmapDecodeSettings settings;
-  uintmax_t file_bytes = 0;
-};
+// The resource key the background work is kept under in the LoadContext.
+const char* const kPrefetchKey = "bitmap prefetch";
 
 void collect_bitmaps(const SceneNode& node, std::set<const SceneNode*>& seen, std::vector<const SceneNode*>& out) {
   if (!seen.insert(&node).second) return;
@@ -54,17 +49,22 @@ std::optional<BitmapDecodeSettings> quiet_settings(const SceneNode& node) {
   return s;
 }
 
-std::vector<DecodeJob> decode_jobs(const LoadContext& ctx) {
+std::vector<BitmapDecodeJob> decode_jobs(const LoadContext& ctx) {
   std::vector<const SceneNode*> nodes;
   std::set<const SceneNode*> seen;
-  if (ctx.desc().root) collect_bitmaps(*ctx.desc().root, seen, nodes);
-  std::vector<DecodeJob> jobs;
+  // From what the scene renders (shapes, emitters, ...), not from top-level bsdf and texture
+  // definitions: those are reached through the references that use them, and one nothing uses
+  // (a wrapper around the bsdf the shapes name, say) is not worth decoding.
+  if (ctx.desc().root)
+    for (const auto& child : ctx.desc().root->children)
+      if (child->tag != "bsdf" && child->tag != "texture") collect_bitmaps(*child, seen, nodes);
+  std::vector<std::pair<uintmax_t, BitmapDecodeJob>> sized;
   std::set<std::string> keys;
   for (const SceneNode* node : nodes) {
     const Property* file = node->peek("filename");
     std::optional<BitmapDecodeSettings> settings = quiet_settings(*node);
     if (!file || file->type != PropType::String || !settings) continue;
-    DecodeJob job;
+    BitmapDecodeJob job;
     try {
       job.path = ctx.locate_file(file->s, file->loc);
     } catch (const SceneError&) {
@@ -72,31 +72,74 @@ std::vector<DecodeJob> decode_jobs(const LoadContext& ctx) {
     }
     job.settings = *settings;
     job.key = bitmap_cache_key(job.path, job.settings);
-    if (ctx.has_resource<DecodedBitmap>(job.key) || !keys.insert(job.key).second) continue;
+    if (!keys.insert(job.key).second) continue;
     std::error_code ec;
-    job.file_bytes = std::filesystem::file_size(job.path, ec);
-    jobs.push_back(std::move(job));
+    const uintmax_t bytes = std::filesystem::file_size(job.path, ec);
+    sized.emplace_back(ec ? 0 : bytes, std::move(job));
   }
   // Largest files first, so that the last image to finish is a small one.
-  std::stable_sort(jobs.begin(), jobs.end(),
-                   [](const DecodeJob& a, const DecodeJob& b) { return a.file_bytes > b.file_bytes; });
+  std::stable_sort(sized.begin(), sized.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::vector<BitmapDecodeJob> jobs;
+  for (auto& [bytes, job] : sized) jobs.push_back(std::move(job));
   return jobs;
 }
 
 }  // namespace
 
-void prefetch_bitmaps(LoadContext& ctx) {
-  const std::vector<DecodeJob> jobs = decode_jobs(ctx);
-  std::vector<std::shared_ptr<const DecodedBitmap>> decoded(jobs.size());
-  tbb::parallel_for(size_t(0), jobs.size(), [&](size_t i) {
+BitmapPrefetch::BitmapPrefetch(std::vector<BitmapDecodeJob> jobs) {
+  for (BitmapDecodeJob& job : jobs) {
+    slots_.push_back(std::make_unique<Slot>());
+    slots_.back()->job = std::move(job);
+    by_key_[slots_.back()->job.key] = slots_.back().get();
+  }
+  for (auto& slot : slots_) tasks_.run([this, s = slot.get()] { run(*s); });
+}
+
+BitmapPrefetch::~BitmapPrefetch() {
+  tasks_.cancel();
+  tasks_.wait();
+}
+
+const std::shared_ptr<const DecodedBitmap>& BitmapPrefetch::run(Slot& slot) const {
+  int expected = kPending;
+  if (slot.state.compare_exchange_strong(expected, kRunning, std::memory_order_acq_rel)) {
     try {
-      decoded[i] = std::make_shared<const DecodedBitmap>(decode_bitmap_file(jobs[i].path, jobs[i].settings));
-    } catch (const std::exception&) {
-      // Left for the factory, which decodes it again and reports the error where the scene names it.
+      slot.result = std::make_shared<const DecodedBitmap>(decode_bitmap_file(slot.job.path, slot.job.settings));
+    } catch (...) {
+      // Left null: the factory decodes the file again and reports the error with its location.
     }
-  });
-  for (size_t i = 0; i < jobs.size(); ++i)
-    if (decoded[i]) ctx.add_resource(jobs[i].key, decoded[i]);
+    slot.state.store(kDone, std::memory_order_release);
+    slot.state.notify_all();
+  } else {
+    for (int s = slot.state.load(std::memory_order_acquire); s != kDone; s = slot.state.load(std::memory_order_acquire))
+      slot.state.wait(s, std::memory_order_acquire);
+  }
+  return slot.result;
+}
+
+std::shared_ptr<const DecodedBitmap> BitmapPrefetch::get(const std::string& key) const {
+  auto it = by_key_.find(key);
+  return it == by_key_.end() ? nullptr : run(*it->second);
+}
+
+size_t BitmapPrefetch::wait_all() const {
+  size_t decoded = 0;
+  for (auto& slot : slots_) decoded += run(*slot) != nullptr;
+  return decoded;
+}
+
+void prefetch_bitmaps(LoadContext& ctx) {
+  try {
+    std::vector<BitmapDecodeJob> jobs = decode_jobs(ctx);
+    if (jobs.empty()) return;
+    ctx.add_resource<BitmapPrefetch>(kPrefetchKey, std::make_shared<BitmapPrefetch>(std::move(jobs)));
+  } catch (const std::exception&) {
+    // Looking ahead is an optimisation: without it, the factory decodes each file itself.
+  }
+}
+
+const BitmapPrefetch* bitmap_prefetch(const LoadContext& ctx) {
+  return ctx.find_resource<BitmapPrefetch>(kPrefetchKey).get();
 }
 
 }  // namespace tessera

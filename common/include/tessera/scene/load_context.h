@@ -93,8 +93,19 @@ class LoadContext {
   bool has_resource(const std::string& key) const {
     return resources_.count({std::type_index(typeid(T)), key}) > 0;
   }
-  /// Number of distinct resources loaded so far.
-  size_t num_cached_resources() const { return resources_.size(); }
+  /// The resource of type T under `key`, or null.
+  template <typename T>
+  std::shared_ptr<const T> find_resource(const std::string& key) const {
+    auto it = resources_.find({std::type_index(typeid(T)), key});
+    return it == resources_.end() ? nullptr : std::static_pointer_cast<const T>(it->second);
+  }
+  /// Number of distinct resources of type T loaded so far.
+  template <typename T>
+  size_t num_resources() const {
+    size_t n = 0;
+    for (const auto& entry : resources_) n += entry.first.first == std::type_index(typeid(T));
+    return n;
+  }
   /// True the first time `what` is asked about in this load, false after: for work done once
   /// per scene (a look-ahead pass, a warning about a shared image).
   bool first_time(const std::string& what) { return done_once_.insert(what).second; }
@@ -142,6 +153,13 @@ class LoadContext {
   mutable std::vector<std::string> resolved_files_;
   mutable std::set<std::string> resolved_set_;
 };
+
+/// A look-ahead pass: started by every LoadContext as it is made, before the build, to read a
+/// plugin's resources in the background (the bitmap decoding). Keeps its work in the context
+/// (add_resource), where the plugin's factory finds it; never throws.
+using LookaheadPass = void (*)(LoadContext&);
+/// The look-ahead passes (factories.cpp), in the order they are started.
+const std::vector<LookaheadPass>& lookahead_passes();
 
 using BsdfFactory = std::shared_ptr<Bsdf> (*)(const SceneNode&, LoadContext&);
 using TextureFactory = std::shared_ptr<Texture> (*)(const SceneNode&, LoadContext&);

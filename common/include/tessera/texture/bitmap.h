@@ -14,6 +14,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace tessera {
 
@@ -86,5 +87,12 @@ class BitmapTexture final : public Texture {
   TextureFilter filter_;
   UvMapping to_uv_;
 };
+
+/// Texel memory of the distinct bitmap images among `textures` (an image shared by several
+/// textures counted once): as stored, and as the same texels would take in float.
+struct TextureMemory {
+  size_t bytes = 0, float_bytes = 0, images = 0;
+};
+TextureMemory texture_memory(const std::vector<std::shared_ptr<Texture>>& textures);
 
 }  // namespace tessera
