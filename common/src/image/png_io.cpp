@@ -74,6 +74,7 @@ int stored_channels(int n) { return n == 1 ? 1 : (n == 3 ? 3 : 4); }
 template <typename T>
 std::vector<T> expand_channels(const T* src, size_t pixels, int n, T opaque) {
   const int channels = stored_channels(n);
+  if (channels == n) return std::vector<T>(src, src + pixels * size_t(n));
   std::vector<T> out(pixels * size_t(channels));
   for (size_t i = 0; i < pixels; ++i) {
     T px[4] = {0, 0, 0, opaque};
