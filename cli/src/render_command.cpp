@@ -7,6 +7,7 @@
 #include "tessera/render/shape.h"
 #include "tessera/scene/load_context.h"
 #include "tessera/scene/scene_desc.h"
+#include "tessera/texture/bitmap.h"
 
 #include <tbb/info.h>
 
@@ -199,9 +200,11 @@ int run_render(const RenderOptions& options) {
     const auto& c = stats.counters;
     const size_t accel = scene.accel_bytes();
     const size_t meshes = mesh_bytes(scene);
+    const TextureMemory textures = texture_memory(scene.textures);
     std::fprintf(stderr,
                  "scene %s: %zu triangles (%llu with instances), %zu shapes, %zu instances, %zu lights (%zu selectable, %s selection); BVH %.1f MB\n"
-                 "memory: BVH %.1f bytes/triangle, meshes %.1f MB (%.1f bytes/triangle)\n"
+                 "memory: BVH %.1f bytes/triangle, meshes %.1f MB (%.1f bytes/triangle), textures %.1f MB in %zu "
+                 "images (%.1f MB as float)\n"
                  "times: parse %.3f s, load %.3f s (BVH build %.3f s), render %.3f s\n"
                  "render: %dx%d, %d spp, %d threads: %.3g samples/s, %.3g rays/s",
                  options.scene.c_str(), scene.num_triangles(), (unsigned long long)scene.num_instanced_triangles(),
@@ -209,7 +212,8 @@ int run_render(const RenderOptions& options) {
                  scene.light_sampler().lights().size(), light_selection_name(scene.light_sampler().strategy()),
                  double(accel) / 1e6,
                  double(accel) / double(std::max<size_t>(scene.num_triangles(), 1)), double(meshes) / 1e6,
-                 double(meshes) / double(std::max<size_t>(scene.num_triangles(), 1)), parse_s, load_s - scene.bvh_build_seconds(),
+                 double(meshes) / double(std::max<size_t>(scene.num_triangles(), 1)), double(textures.bytes) / 1e6,
+                 textures.images, double(textures.float_bytes) / 1e6, parse_s, load_s - scene.bvh_build_seconds(),
                  scene.bvh_build_seconds(), stats.seconds, film.width(), film.height(), settings.spp,
                  settings.threads, double(c.samples) / std::max(stats.seconds, 1e-9),
                  double(c.rays()) / std::max(stats.seconds, 1e-9));

@@ -1,6 +1,7 @@
 // OpenEXR through the general FrameBuffer API, so that half and float channels, tiled files and
 // data windows not at the origin are all read the same way.
 #include "tessera/image/image.h"
+#include "tessera/image/packed_image.h"
 
 #include "image/io_util.h"
 
@@ -42,6 +43,45 @@ bool parse_int32(const std::string& s, int& out) {
   return ec == std::errc() && ptr == s.data() + s.size();
 }
 
+// The data window's size, checked; and the channels to read (R,G,B[,A] or Y), checked.
+struct ExrLayout {
+  Imath::Box2i dw;
+  int width = 0, height = 0;
+  std::vector<std::string> names;
+  bool all_half = true;  // every channel read is stored as half
+};
+
+ExrLayout exr_layout(const std::string& path, const Imf::Header& header) {
+  ExrLayout out;
+  out.dw = header.dataWindow();
+  const Imath::Box2i& dw = out.dw;
+  long long w = (long long)dw.max.x - dw.min.x + 1, h = (long long)dw.max.y - dw.min.y + 1;
+  if (w <= 0 || h <= 0 || w > INT_MAX / 4 || h > INT_MAX / 4 || w * h > (1LL << 31))
+    fail(path, "EXR data window is empty or too large");
+  out.width = int(w), out.height = int(h);
+
+  const Imf::ChannelList& ch = header.channels();
+  bool has_r = ch.findChannel("R"), has_g = ch.findChannel("G"), has_b = ch.findChannel("B");
+  bool has_a = ch.findChannel("A"), has_y = ch.findChannel("Y");
+  if (has_r || has_g || has_b) {
+    if (!(has_r && has_g && has_b)) fail(path, "EXR has only some of the channels R, G, B");
+    out.names = {"R", "G", "B"};
+    if (has_a) out.names.push_back("A");
+  } else if (has_y) {
+    out.names = {"Y"};  // a luminance image: alpha, if any, is dropped
+  } else {
+    std::string found;
+    for (auto it = ch.begin(); it != ch.end(); ++it) found += std::string(found.empty() ? "" : ", ") + it.name();
+    fail(path, "EXR has no R,G,B or Y channels (found: " + (found.empty() ? "none" : found) + ")");
+  }
+  for (const auto& n : out.names) {
+    const Imf::Channel* c = ch.findChannel(n);
+    if (c->xSampling != 1 || c->ySampling != 1) fail(path, "EXR channel " + n + " is subsampled (unsupported)");
+    if (c->type != Imf::HALF) out.all_half = false;
+  }
+  return out;
+}
+
 }  // namespace
 
 Image read_exr(const std::string& path, ImageAttributes* attributes) {
@@ -49,32 +89,13 @@ Image read_exr(const std::string& path, ImageAttributes* attributes) {
   try {
     Imf::InputFile file(path.c_str());
     const Imf::Header& header = file.header();
-    const Imath::Box2i dw = header.dataWindow();
-    long long w = (long long)dw.max.x - dw.min.x + 1, h = (long long)dw.max.y - dw.min.y + 1;
-    if (w <= 0 || h <= 0 || w > INT_MAX / 4 || h > INT_MAX / 4 || w * h > (1LL << 31))
-      fail(path, "EXR data window is empty or too large");
+    const ExrLayout layout = exr_layout(path, header);
+    const Imath::Box2i& dw = layout.dw;
+    const std::vector<std::string>& names = layout.names;
+    const size_t w = size_t(layout.width);
+    const int h = layout.height;
 
-    const Imf::ChannelList& ch = header.channels();
-    bool has_r = ch.findChannel("R"), has_g = ch.findChannel("G"), has_b = ch.findChannel("B");
-    bool has_a = ch.findChannel("A"), has_y = ch.findChannel("Y");
-    std::vector<std::string> names;
-    if (has_r || has_g || has_b) {
-      if (!(has_r && has_g && has_b)) fail(path, "EXR has only some of the channels R, G, B");
-      names = {"R", "G", "B"};
-      if (has_a) names.push_back("A");
-    } else if (has_y) {
-      names = {"Y"};  // a luminance image: alpha, if any, is dropped
-    } else {
-      std::string found;
-      for (auto it = ch.begin(); it != ch.end(); ++it) found += std::string(found.empty() ? "" : ", ") + it.name();
-      fail(path, "EXR has no R,G,B or Y channels (found: " + (found.empty() ? "none" : found) + ")");
-    }
-    for (const auto& n : names) {
-      const Imf::Channel* c = ch.findChannel(n);
-      if (c->xSampling != 1 || c->ySampling != 1) fail(path, "EXR channel " + n + " is subsampled (unsupported)");
-    }
-
-    Image img(int(w), int(h), int(names.size()));
+    Image img(int(w), h, int(names.size()));
     Imf::FrameBuffer fb;
     size_t xstride = sizeof(float) * names.size(), ystride = xstride * size_t(w);
     for (size_t c = 0; c < names.size(); ++c)
@@ -91,6 +112,39 @@ Image read_exr(const std::string& path, ImageAttributes* attributes) {
           (*attributes)[it.name()] = std::to_string(i->value());
       }
     }
+    return img;
+  } catch (const SceneError&) {
+    throw;
+  } catch (const std::exception& e) {
+    fail(path, std::string("cannot read EXR: ") + e.what());
+  }
+}
+
+PackedImage read_exr_packed(const std::string& path) {
+  image_detail::require_readable_file(path);
+  try {
+    Imf::InputFile file(path.c_str());
+    const ExrLayout layout = exr_layout(path, file.header());
+    PackedImage img;
+    img.width = layout.width, img.height = layout.height, img.channels = int(layout.names.size());
+    // Half files stay half; anything else (float, uint) is read as float, as read_exr does.
+    img.format = layout.all_half ? PixelFormat::Half : PixelFormat::F32;
+    const size_t value_size = layout.all_half ? sizeof(uint16_t) : sizeof(float);
+    char* base;
+    if (layout.all_half) {
+      img.u16.resize(img.num_values());
+      base = reinterpret_cast<char*>(img.u16.data());
+    } else {
+      img.f32.resize(img.num_values());
+      base = reinterpret_cast<char*>(img.f32.data());
+    }
+    Imf::FrameBuffer fb;
+    const size_t xstride = value_size * layout.names.size(), ystride = xstride * size_t(layout.width);
+    for (size_t c = 0; c < layout.names.size(); ++c)
+      fb.insert(layout.names[c], Imf::Slice::Make(layout.all_half ? Imf::HALF : Imf::FLOAT, base + c * value_size,
+                                                  layout.dw, xstride, ystride));
+    file.setFrameBuffer(fb);
+    file.readPixels(layout.dw.min.y, layout.dw.max.y);
     return img;
   } catch (const SceneError&) {
     throw;

@@ -1,6 +1,7 @@
 // 8-bit output through stb_image_write (PNG) and everything stb_image reads (PNG, JPEG, TGA, BMP,
 // Radiance .hdr), plus Radiance .hdr output. stb's implementation is compiled into libstb.
 #include "tessera/image/image.h"
+#include "tessera/image/packed_image.h"
 
 #include "image/io_util.h"
 
@@ -65,42 +66,53 @@ void write_hdr(const std::string& path, const Image& image_in) {
     fail(path, "cannot write Radiance HDR");
 }
 
-Image read_stb(const std::string& path) {
+namespace {
+
+// stb's n channels -> ours: grey+alpha becomes RGBA (grey replicated), others stay.
+int stored_channels(int n) { return n == 1 ? 1 : (n == 3 ? 3 : 4); }
+
+template <typename T>
+std::vector<T> expand_channels(const T* src, size_t pixels, int n, T opaque) {
+  const int channels = stored_channels(n);
+  if (channels == n) return std::vector<T>(src, src + pixels * size_t(n));
+  std::vector<T> out(pixels * size_t(channels));
+  for (size_t i = 0; i < pixels; ++i) {
+    T px[4] = {0, 0, 0, opaque};
+    for (int c = 0; c < n; ++c) px[c] = src[i * size_t(n) + size_t(c)];
+    if (n == 2) px[3] = px[1], px[1] = px[2] = px[0];
+    for (int c = 0; c < channels; ++c) out[i * size_t(channels) + size_t(c)] = px[c];
+  }
+  return out;
+}
+
+}  // namespace
+
+PackedImage read_stb_packed(const std::string& path) {
   image_detail::require_readable_file(path);
   int w = 0, h = 0, n = 0;
-  Image img;
+  PackedImage img;
   if (stbi_is_hdr(path.c_str())) {
     std::unique_ptr<float, StbFree> data(stbi_loadf(path.c_str(), &w, &h, &n, 0));
     if (!data) fail(path, "cannot read image: " + stb_reason());
-    int channels = (n == 1) ? 1 : (n == 3 ? 3 : 4);
-    img = Image(w, h, channels);
-    const float* src = data.get();
-    for (size_t i = 0; i < img.num_pixels(); ++i) {
-      float px[4] = {0, 0, 0, 1};
-      for (int c = 0; c < n; ++c) px[c] = src[i * size_t(n) + size_t(c)];
-      if (n == 2) px[3] = px[1], px[1] = px[2] = px[0];
-      for (int c = 0; c < channels; ++c) img.data()[i * size_t(channels) + size_t(c)] = px[c];
-    }
+    img.width = w, img.height = h, img.channels = stored_channels(n), img.format = PixelFormat::F32;
+    img.f32 = expand_channels(data.get(), img.num_pixels(), n, 1.f);
     return img;
   }
-  bool wide = stbi_is_16_bit(path.c_str());
-  std::unique_ptr<void, StbFree> data(wide ? static_cast<void*>(stbi_load_16(path.c_str(), &w, &h, &n, 0))
-                                           : static_cast<void*>(stbi_load(path.c_str(), &w, &h, &n, 0)));
-  if (!data) fail(path, "cannot read image: " + stb_reason());
-  int channels = (n == 1) ? 1 : (n == 3 ? 3 : 4);
-  img = Image(w, h, channels);
-  float max_code = wide ? 65535.f : 255.f;  // divide (not multiply by 1/255): code k reads as exactly k/255
-  for (size_t i = 0; i < img.num_pixels(); ++i) {
-    float px[4] = {0, 0, 0, 1};
-    for (int c = 0; c < n; ++c) {
-      size_t k = i * size_t(n) + size_t(c);
-      px[c] = float(wide ? static_cast<const uint16_t*>(data.get())[k] : static_cast<const uint8_t*>(data.get())[k]) / max_code;
-    }
-    if (n == 2) px[3] = px[1], px[1] = px[2] = px[0];
-    for (int c = 0; c < channels; ++c) img.data()[i * size_t(channels) + size_t(c)] = px[c];
+  if (stbi_is_16_bit(path.c_str())) {
+    std::unique_ptr<uint16_t, StbFree> data(stbi_load_16(path.c_str(), &w, &h, &n, 0));
+    if (!data) fail(path, "cannot read image: " + stb_reason());
+    img.width = w, img.height = h, img.channels = stored_channels(n), img.format = PixelFormat::U16;
+    img.u16 = expand_channels(data.get(), img.num_pixels(), n, uint16_t(65535));
+  } else {
+    std::unique_ptr<uint8_t, StbFree> data(stbi_load(path.c_str(), &w, &h, &n, 0));
+    if (!data) fail(path, "cannot read image: " + stb_reason());
+    img.width = w, img.height = h, img.channels = stored_channels(n), img.format = PixelFormat::U8;
+    img.u8 = expand_channels(data.get(), img.num_pixels(), n, uint8_t(255));
   }
-  img.set_srgb_encoded(true);
+  img.srgb_encoded = true;
   return img;
 }
+
+Image read_stb(const std::string& path) { return read_stb_packed(path).to_image(); }
 
 }  // namespace tessera

@@ -30,6 +30,8 @@ std::shared_ptr<Bsdf> make_null(const SceneNode&, LoadContext&);
 std::shared_ptr<Texture> make_bitmap(const SceneNode&, LoadContext&);
 std::shared_ptr<Texture> make_checkerboard(const SceneNode&, LoadContext&);
 std::shared_ptr<Texture> make_scale(const SceneNode&, LoadContext&);
+// -- look-ahead passes --
+void prefetch_bitmaps(LoadContext&);
 // -- lights --
 std::unique_ptr<Light> make_point(const SceneNode&, LoadContext&);
 std::unique_ptr<Light> make_spot(const SceneNode&, LoadContext&);
@@ -147,6 +149,11 @@ std::vector<std::string> registered_plugins(const std::string& tag) {
     return out;
   }
   return {};
+}
+
+const std::vector<LookaheadPass>& lookahead_passes() {
+  static const std::vector<LookaheadPass> passes = {prefetch_bitmaps};
+  return passes;
 }
 
 BsdfFactory find_bsdf_factory(const std::string& type) { return type.empty() ? nullptr : find(kBsdfs, type); }

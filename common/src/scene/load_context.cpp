@@ -16,9 +16,17 @@ namespace tessera {
 namespace fs = std::filesystem;
 
 LoadContext::LoadContext(const SceneDesc& desc, const LoadOptions& options, Scene& scene)
-    : desc_(desc), options_(options), scene_(scene) {}
+    : desc_(desc), options_(options), scene_(scene) {
+  for (LookaheadPass pass : lookahead_passes()) pass(*this);
+}
 
 std::string LoadContext::resolve_path(const std::string& name, const FileLoc& loc) const {
+  std::string path = locate_file(name, loc);
+  if (resolved_set_.insert(path).second) resolved_files_.push_back(path);
+  return path;
+}
+
+std::string LoadContext::locate_file(const std::string& name, const FileLoc& loc) const {
   if (name.empty()) throw SceneError(loc, "empty file name");
   // The scene's directory first (Mitsuba's resolver), then the directory of the XML file that
   // names the file (an included file's neighbours). Windows separators in old scenes are accepted.
@@ -50,7 +58,6 @@ std::string LoadContext::resolve_path(const std::string& name, const FileLoc& lo
     if (!fs::is_regular_file(c, ec)) continue;
     if (!detail::canonically_inside(root, c)) detail::throw_outside_root(loc, name);
     if (!std::ifstream(c, std::ios::binary)) throw SceneError(loc, "cannot read '" + c.string() + "'");
-    if (resolved_set_.insert(c.string()).second) resolved_files_.push_back(c.string());
     return c.string();
   }
   if (skipped_outside) detail::throw_outside_root(loc, name);
@@ -89,15 +96,6 @@ std::shared_ptr<const MeshData> LoadContext::cached_mesh(const std::string& key,
   auto mesh = std::make_shared<const MeshData>(load());
   meshes_.emplace(key, mesh);
   return mesh;
-}
-
-std::shared_ptr<const Image> LoadContext::cached_image(const std::string& key,
-                                                      const std::function<Image()>& load) {
-  auto it = images_.find(key);
-  if (it != images_.end()) return it->second;
-  auto image = std::make_shared<const Image>(load());
-  images_.emplace(key, image);
-  return image;
 }
 
 const Bsdf* LoadContext::bsdf(const std::shared_ptr<SceneNode>& node) {

@@ -4,10 +4,12 @@
 #include "tessera/texture/bitmap.h"
 
 #include "tessera/scene/load_context.h"
+#include "tessera/texture/bitmap_prefetch.h"
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <set>
 
 namespace tessera {
 
@@ -27,20 +29,15 @@ UvMapping::UvMapping(const Transform& to_uv) {
   m_[3] = float(m[1][0]), m_[4] = float(m[1][1]), m_[5] = float(m[1][3]);
 }
 
-BitmapTexture::BitmapTexture(std::shared_ptr<const Image> image, WrapMode wrap_u, WrapMode wrap_v,
+BitmapTexture::BitmapTexture(std::shared_ptr<const TexelStorage> texels, WrapMode wrap_u, WrapMode wrap_v,
                              TextureFilter filter, UvMapping to_uv)
-    : image_(std::move(image)), wrap_u_(wrap_u), wrap_v_(wrap_v), filter_(filter), to_uv_(to_uv) {
-  TESSERA_CHECK(image_ && !image_->empty());
-  // Summed in double: large textures would otherwise lose the small texels.
-  double sum[3] = {0, 0, 0};
-  for (int y = 0; y < image_->height(); ++y)
-    for (int x = 0; x < image_->width(); ++x) {
-      Rgb c = image_->rgb(x, y);
-      for (int i = 0; i < 3; ++i) sum[i] += double(c[i]);
-    }
-  double n = double(image_->num_pixels());
-  mean_ = Rgb(float(sum[0] / n), float(sum[1] / n), float(sum[2] / n));
+    : texels_(std::move(texels)), wrap_u_(wrap_u), wrap_v_(wrap_v), filter_(filter), to_uv_(to_uv) {
+  TESSERA_CHECK(texels_ && !texels_->empty());
 }
+
+BitmapTexture::BitmapTexture(const std::shared_ptr<const Image>& image, WrapMode wrap_u, WrapMode wrap_v,
+                             TextureFilter filter, UvMapping to_uv)
+    : BitmapTexture(std::make_shared<const TexelStorage>(*image), wrap_u, wrap_v, filter, to_uv) {}
 
 int BitmapTexture::wrap(int i, int n, WrapMode mode) {
   switch (mode) {
@@ -63,9 +60,9 @@ int BitmapTexture::wrap(int i, int n, WrapMode mode) {
 template <typename T, typename Fetch>
 T BitmapTexture::texel(int x, int y, Fetch fetch) const {
   // u decided first, as Mitsuba does.
-  int xi = wrap(x, image_->width(), wrap_u_);
+  int xi = wrap(x, texels_->width(), wrap_u_);
   if (xi < 0) return T(xi == -1 ? 0.f : 1.f);
-  int yi = wrap(y, image_->height(), wrap_v_);
+  int yi = wrap(y, texels_->height(), wrap_v_);
   if (yi < 0) return T(yi == -1 ? 0.f : 1.f);
   return fetch(xi, yi);
 }
@@ -74,7 +71,7 @@ template <typename Fetch>
 auto BitmapTexture::filtered(Vec2 uv, Fetch fetch) const {
   using T = decltype(fetch(0, 0));
   auto texel = [&](int x, int y) -> T { return this->texel<T>(x, y, fetch); };
-  float u = uv.x * float(image_->width()), v = uv.y * float(image_->height());
+  float u = uv.x * float(texels_->width()), v = uv.y * float(texels_->height());
   // NaN/huge coordinates would overflow the integer conversion; Mitsuba returns 0 for NaN.
   if (!(std::abs(u) < 1e9f) || !(std::abs(v) < 1e9f)) return T(0.f);
   if (filter_ == TextureFilter::Nearest) return texel(int(std::floor(u)), int(std::floor(v)));
@@ -88,31 +85,36 @@ auto BitmapTexture::filtered(Vec2 uv, Fetch fetch) const {
 }
 
 Rgb BitmapTexture::lookup(Vec2 uv) const {
-  return filtered(uv, [this](int x, int y) { return image_->rgb(x, y); });
+  const TexelStorage& t = *texels_;
+  return t.visit([&](auto format) {
+    return filtered(uv, [&t](int x, int y) { return t.rgb_as<decltype(format)::value>(x, y); });
+  });
 }
 
 float BitmapTexture::lookup_channel(Vec2 uv, int channel) const {
   TESSERA_DCHECK(channel >= 0 && channel < 4);
-  const Image& im = *image_;
-  if (channel == 3 && !im.has_alpha()) return 1.f;
-  int c = im.channels() == 1 && channel < 3 ? 0 : channel;
-  return filtered(uv, [&im, c](int x, int y) { return im.at(x, y, c); });
+  const TexelStorage& t = *texels_;
+  if (channel == 3 && !t.has_alpha()) return 1.f;
+  int c = t.channels() == 1 && channel < 3 ? 0 : channel;
+  return t.visit([&](auto format) {
+    return filtered(uv, [&t, c](int x, int y) { return t.at_as<decltype(format)::value>(x, y, c); });
+  });
 }
 
 float BitmapTexture::eval_1(const SurfaceInteraction& si) const {
   Vec2 uv = to_uv_.apply(si.uv);
-  if (image_->channels() == 1) return lookup_channel(uv, 0);
+  if (texels_->channels() == 1) return lookup_channel(uv, 0);
   return lookup(uv).average();
 }
 
+template <TexelStorage::Format F>
 Vec2 BitmapTexture::lookup_gradient_1(Vec2 uv) const {
-  if (filter_ == TextureFilter::Nearest) return {};
-  const Image& im = *image_;
+  const TexelStorage& t = *texels_;
   // The same scalar as eval_1: channel 0 of grey images, else the mean of r, g, b.
-  auto fetch = [&im](int x, int y) {
-    return im.channels() == 1 ? im.at(x, y, 0) : im.rgb(x, y).average();
+  auto fetch = [&t](int x, int y) {
+    return t.channels() == 1 ? t.at_as<F>(x, y, 0) : t.rgb_as<F>(x, y).average();
   };
-  const float w = float(im.width()), h = float(im.height());
+  const float w = float(t.width()), h = float(t.height());
   float u = uv.x * w, v = uv.y * h;
   if (!(std::abs(u) < 1e9f) || !(std::abs(v) < 1e9f)) return {};
   u -= 0.5f;
@@ -127,40 +129,22 @@ Vec2 BitmapTexture::lookup_gradient_1(Vec2 uv) const {
 }
 
 Vec2 BitmapTexture::eval_1_gradient(const SurfaceInteraction& si) const {
-  return to_uv_.pull_back(lookup_gradient_1(to_uv_.apply(si.uv)));
+  if (filter_ == TextureFilter::Nearest) return to_uv_.pull_back({});
+  const Vec2 uv = to_uv_.apply(si.uv);
+  return to_uv_.pull_back(texels_->visit([&](auto format) { return lookup_gradient_1<decltype(format)::value>(uv); }));
 }
 
-Image decode_bitmap_values(const Image& stored, float gamma, bool raw) {
-  if (gamma == 0.f) {
-    if (!raw) return stored.linearized();
-    Image out = stored;
-    out.set_srgb_encoded(false);
-    return out;
+TextureMemory texture_memory(const std::vector<std::shared_ptr<Texture>>& textures) {
+  TextureMemory m;
+  std::set<const TexelStorage*> seen;
+  for (const auto& t : textures) {
+    const auto* b = dynamic_cast<const BitmapTexture*>(t.get());
+    if (!b || !seen.insert(b->texels().get()).second) continue;
+    m.bytes += b->texels()->bytes();
+    m.float_bytes += b->texels()->float_bytes();
+    ++m.images;
   }
-  Image out = stored;
-  out.set_srgb_encoded(false);
-  int colour_channels = out.channels() == 4 ? 3 : out.channels();
-  float* px = out.data();
-  for (size_t i = 0; i < out.num_pixels(); ++i)
-    for (int c = 0; c < colour_channels; ++c) {
-      float& v = px[i * size_t(out.channels()) + size_t(c)];
-      if (gamma < 0.f)
-        v = srgb_to_linear(v);
-      else
-        v = std::copysign(std::pow(std::abs(v), gamma), v);
-    }
-  return out;
-}
-
-Image extract_channel(const Image& image, int channel) {
-  const int c = image.channels() == 1 && channel < 3 ? 0 : channel;
-  if (c >= image.channels())
-    throw SceneError("has no channel '" + std::string(1, "rgba"[channel]) + "' (" +
-                     std::to_string(image.channels()) + " channel(s))");
-  Image out(image.width(), image.height(), 1);
-  for (int y = 0; y < image.height(); ++y)
-    for (int x = 0; x < image.width(); ++x) out.at(x, y, 0) = image.at(x, y, c);
-  return out;
+  return m;
 }
 
 namespace {
@@ -227,31 +211,27 @@ std::shared_ptr<Texture> make_bitmap(const SceneNode& node, LoadContext& ctx) {
   if (channel_index == -2)
     throw SceneError(node.find("channel")->loc, node.describe() + ": unknown channel '" + channel + "' (r, g, b, a)");
 
-  std::string key = path + "|gamma=" + std::to_string(gamma) + "|raw=" + (raw ? "1" : "0") + "|channel=" + channel;
-  std::shared_ptr<const Image> image = ctx.cached_image(key, [&] {
+  const BitmapDecodeSettings settings{gamma, raw, channel_index};
+  const std::string key = bitmap_cache_key(path, settings);
+  // Decoded in the background since the load began (bitmap_prefetch.h), unless the look-ahead
+  // missed this one or could not read it: then here, where an error can name the scene's line.
+  if (!ctx.has_resource<DecodedBitmap>(key))
+    if (const BitmapPrefetch* ahead = bitmap_prefetch(ctx))
+      if (auto d = ahead->get(key)) ctx.add_resource(key, std::move(d));
+  std::shared_ptr<const DecodedBitmap> decoded = ctx.cached_resource<DecodedBitmap>(key, [&] {
     try {
-      Image stored = read_image(path);
-      if (stored.empty()) throw SceneError("image has no pixels");
-      Image decoded = decode_bitmap_values(stored, gamma, raw);
-      if (channel_index >= 0) decoded = extract_channel(decoded, channel_index);
-      // A NaN or infinite texel would turn every path that touches it into a dropped sample;
-      // read it as 0, as envmaps do (envmap.cpp), and say so once per image.
-      size_t bad = 0;
-      for (float* v = decoded.data(), *end = v + decoded.values().size(); v != end; ++v) {
-        if (std::isfinite(*v)) continue;
-        *v = 0.f;
-        ++bad;
-      }
-      if (bad)
-        ctx.warn(file->loc, node.describe() + ": " + std::to_string(bad) + " non-finite texel value(s) in '" + name +
-                                "' read as 0");
-      return decoded;
+      return decode_bitmap_file(path, settings);
     } catch (const SceneError& e) {
       // The reader names the file; the scene location says which texture wanted it.
       throw SceneError(file->loc, node.describe() + ": " + e.what());
     }
   });
-  return std::make_shared<BitmapTexture>(std::move(image), wrap_u, wrap_v, filter, to_uv);
+  if (decoded->nonfinite && ctx.first_time("non-finite texels|" + key))
+    ctx.warn(file->loc, node.describe() + ": " + std::to_string(decoded->nonfinite) +
+                            " non-finite texel value(s) in '" + name + "' read as 0");
+  // Shares the cache entry's ownership, pointing at its texels.
+  std::shared_ptr<const TexelStorage> texels(decoded, &decoded->texels);
+  return std::make_shared<BitmapTexture>(std::move(texels), wrap_u, wrap_v, filter, to_uv);
 }
 
 }  // namespace tessera

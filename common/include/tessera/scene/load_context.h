@@ -20,6 +20,9 @@
 #include <memory>
 #include <set>
 #include <string>
+#include <typeindex>
+#include <typeinfo>
+#include <utility>
 #include <vector>
 
 namespace tessera {
@@ -53,6 +56,9 @@ class LoadContext {
   /// file does not exist or cannot be read, or lies outside root_dir() ("file 'X' is outside the
   /// scene bundle"; candidates outside are never looked at on disk).
   std::string resolve_path(const std::string& name, const FileLoc& loc) const;
+  /// resolve_path without counting the file among resolved_files(): for look-ahead passes, which
+  /// must not change which files a scene is said to need, nor their order.
+  std::string locate_file(const std::string& name, const FileLoc& loc) const;
   /// The directory files must stay inside: LoadOptions::root_dir, else SceneDesc::root_dir; empty
   /// when unconfined.
   const std::string& root_dir() const {
@@ -67,11 +73,42 @@ class LoadContext {
   std::shared_ptr<const MeshData> cached_mesh(const std::string& key,
                                               const std::function<MeshData()>& load);
 
-  /// Decodes an image once per key (resolved path plus whatever changes the decoded values, e.g.
-  /// gamma) and shares it: a file used by several textures is read once per scene.
-  std::shared_ptr<const Image> cached_image(const std::string& key, const std::function<Image()>& load);
-  /// Number of distinct images decoded so far.
-  size_t num_cached_images() const { return images_.size(); }
+  /// Loads a resource (a decoded image, ...) once per type and key (resolved path plus whatever
+  /// changes the result, e.g. gamma) and shares it: a file used by several textures is read once
+  /// per scene.
+  template <typename T>
+  std::shared_ptr<const T> cached_resource(const std::string& key, const std::function<T()>& load) {
+    auto& slot = resources_[{std::type_index(typeid(T)), key}];
+    if (!slot) slot = std::make_shared<const T>(load());
+    return std::static_pointer_cast<const T>(slot);
+  }
+  /// Stores a resource made ahead of its use (a look-ahead pass decoding files in parallel);
+  /// a key already present keeps its resource.
+  template <typename T>
+  void add_resource(const std::string& key, std::shared_ptr<const T> resource) {
+    auto& slot = resources_[{std::type_index(typeid(T)), key}];
+    if (!slot) slot = std::move(resource);
+  }
+  template <typename T>
+  bool has_resource(const std::string& key) const {
+    return resources_.count({std::type_index(typeid(T)), key}) > 0;
+  }
+  /// The resource of type T under `key`, or null.
+  template <typename T>
+  std::shared_ptr<const T> find_resource(const std::string& key) const {
+    auto it = resources_.find({std::type_index(typeid(T)), key});
+    return it == resources_.end() ? nullptr : std::static_pointer_cast<const T>(it->second);
+  }
+  /// Number of distinct resources of type T loaded so far.
+  template <typename T>
+  size_t num_resources() const {
+    size_t n = 0;
+    for (const auto& entry : resources_) n += entry.first.first == std::type_index(typeid(T));
+    return n;
+  }
+  /// True the first time `what` is asked about in this load, false after: for work done once
+  /// per scene (a look-ahead pass, a warning about a shared image).
+  bool first_time(const std::string& what) { return done_once_.insert(what).second; }
 
   /// Builds (once per node) the BSDF a shape refers to; null node -> the default diffuse BSDF.
   /// texture() and bsdf() mark the nested node consumed; a factory that uses a nested node any
@@ -110,11 +147,19 @@ class LoadContext {
   std::map<const SceneNode*, const Medium*> media_;
   const Bsdf* null_bsdf_ = nullptr;
   std::map<std::string, std::shared_ptr<const MeshData>> meshes_;
-  std::map<std::string, std::shared_ptr<const Image>> images_;
+  std::map<std::pair<std::type_index, std::string>, std::shared_ptr<const void>> resources_;
+  std::set<std::string> done_once_;
   // resolve_path is const (a look-up) yet records what it found.
   mutable std::vector<std::string> resolved_files_;
   mutable std::set<std::string> resolved_set_;
 };
+
+/// A look-ahead pass: started by every LoadContext as it is made, before the build, to read a
+/// plugin's resources in the background (the bitmap decoding). Keeps its work in the context
+/// (add_resource), where the plugin's factory finds it; never throws.
+using LookaheadPass = void (*)(LoadContext&);
+/// The look-ahead passes (factories.cpp), in the order they are started.
+const std::vector<LookaheadPass>& lookahead_passes();
 
 using BsdfFactory = std::shared_ptr<Bsdf> (*)(const SceneNode&, LoadContext&);
 using TextureFactory = std::shared_ptr<Texture> (*)(const SceneNode&, LoadContext&);

@@ -8,10 +8,13 @@
 #include "tessera/core/transform.h"
 #include "tessera/image/image.h"
 #include "tessera/render/texture.h"
+#include "tessera/texture/bitmap_decode.h"
+#include "tessera/texture/texel_storage.h"
 
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace tessera {
 
@@ -41,8 +44,11 @@ class UvMapping {
 
 class BitmapTexture final : public Texture {
  public:
-  /// `image` holds linear values (decoding already done), 1, 3 or 4 channels.
-  BitmapTexture(std::shared_ptr<const Image> image, WrapMode wrap_u, WrapMode wrap_v,
+  /// `texels` hold linear values (decoding already done), 1, 3 or 4 channels.
+  BitmapTexture(std::shared_ptr<const TexelStorage> texels, WrapMode wrap_u, WrapMode wrap_v,
+                TextureFilter filter = TextureFilter::Bilinear, UvMapping to_uv = {});
+  /// Float texels, copied from an image of linear values.
+  BitmapTexture(const std::shared_ptr<const Image>& image, WrapMode wrap_u, WrapMode wrap_v,
                 TextureFilter filter = TextureFilter::Bilinear, UvMapping to_uv = {});
 
   Rgb eval(const SurfaceInteraction& si) const override { return lookup(to_uv_.apply(si.uv)); }
@@ -52,14 +58,15 @@ class BitmapTexture final : public Texture {
   Vec2 eval_1_gradient(const SurfaceInteraction& si) const override;
   /// Alpha channel at the surface point (1 for images without alpha); for masks.
   float alpha(const SurfaceInteraction& si) const { return lookup_channel(to_uv_.apply(si.uv), 3); }
-  Rgb mean() const override { return mean_; }
+  Rgb mean() const override { return texels_->mean(); }
 
   /// Colour at texture coordinates already mapped by to_uv.
   Rgb lookup(Vec2 uv) const;
   /// One channel (0..3; 3 = alpha, 1 when absent) at mapped texture coordinates.
   float lookup_channel(Vec2 uv, int channel) const;
 
-  const std::shared_ptr<const Image>& image() const { return image_; }
+  /// The texels, shared by every texture of the scene that decodes the same file the same way.
+  const std::shared_ptr<const TexelStorage>& texels() const { return texels_; }
   WrapMode wrap_u() const { return wrap_u_; }
   WrapMode wrap_v() const { return wrap_v_; }
 
@@ -72,21 +79,20 @@ class BitmapTexture final : public Texture {
   template <typename Fetch>
   auto filtered(Vec2 uv, Fetch fetch) const;
   /// Gradient of the scalar bilinear interpolant at mapped coordinates.
+  template <TexelStorage::Format F>
   Vec2 lookup_gradient_1(Vec2 uv) const;
 
-  std::shared_ptr<const Image> image_;
+  std::shared_ptr<const TexelStorage> texels_;
   WrapMode wrap_u_, wrap_v_;
   TextureFilter filter_;
   UvMapping to_uv_;
-  Rgb mean_;
 };
 
-/// How Mitsuba decodes a bitmap's stored values into linear ones: `gamma` 0 = automatic (sRGB for
-/// 8-bit files, linear for float files, unless `raw`), -1 = sRGB curve, g > 0 = v^g. Alpha is
-/// never decoded.
-Image decode_bitmap_values(const Image& stored, float gamma, bool raw);
-/// Channel `channel` (0..3 = r, g, b, a) of `image` as a one-channel image; a one-channel image
-/// serves r, g and b. Throws SceneError (without a location) when the image lacks the channel.
-Image extract_channel(const Image& image, int channel);
+/// Texel memory of the distinct bitmap images among `textures` (an image shared by several
+/// textures counted once): as stored, and as the same texels would take in float.
+struct TextureMemory {
+  size_t bytes = 0, float_bytes = 0, images = 0;
+};
+TextureMemory texture_memory(const std::vector<std::shared_ptr<Texture>>& textures);
 
 }  // namespace tessera
