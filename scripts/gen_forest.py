@@ -106,7 +106,7 @@ def main():
     side = math.ceil(math.sqrt(args.count))
     spacing = 3.2
     half = side * spacing / 2
-    lines = [SCENE_HEAD.format(count=args.count, triangles=len(cf) + len(tf), back=half + 6, ground=half + 4)]
+    lines = [SCENE_HEAD.format(count=args.count, triangles=len(cf) + len(tf), back=half + 6, ground=20 * half)]
     for k in range(args.count):
         x = -half + spacing * (k % side + 0.5) + rng.uniform(-1.0, 1.0)
         z = -half + spacing * (k // side + 0.5) + rng.uniform(-1.0, 1.0)
