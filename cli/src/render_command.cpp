@@ -16,7 +16,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
-#include <set>
 
 namespace tessera::cli {
 namespace {
@@ -44,20 +43,6 @@ std::vector<std::string> output_paths(const RenderOptions& options, const Scene&
   std::vector<std::string> outs = {stem + ".exr"};
   if (scene.film.ldr) outs.push_back(stem + ".png");
   return outs;
-}
-
-// Bytes of the triangle meshes' vertex and index arrays (a mesh shared by shapes counted once).
-size_t mesh_bytes(const Scene& scene) {
-  std::set<const MeshData*> seen;
-  size_t bytes = 0;
-  for (const auto& shape : scene.shapes) {
-    if (shape->kind() != Shape::Kind::Mesh) continue;
-    const MeshData& m = static_cast<const TriangleMeshShape&>(*shape).mesh();
-    if (!seen.insert(&m).second) continue;
-    bytes += m.positions.size() * sizeof(Vec3) + m.normals.size() * sizeof(Vec3) + m.uvs.size() * sizeof(Vec2) +
-             m.indices.size() * sizeof(uint32_t);
-  }
-  return bytes;
 }
 
 void write_output(const std::string& out, const Scene& scene, const Image& image, const std::vector<ImageLayer>& layers,
@@ -199,7 +184,7 @@ int run_render(const RenderOptions& options) {
 
     const auto& c = stats.counters;
     const size_t accel = scene.accel_bytes();
-    const size_t meshes = mesh_bytes(scene);
+    const size_t meshes = scene.memory().meshes;
     const TextureMemory textures = texture_memory(scene.textures);
     std::fprintf(stderr,
                  "scene %s: %zu triangles (%llu with instances), %zu shapes, %zu instances, %zu lights (%zu selectable, %s selection); BVH %.1f MB\n"

@@ -108,10 +108,9 @@ ApiReply<std::optional<Lease>> FarmApi::lease(uint64_t worker, double wait, doub
   return decode_lease_reply(http_.post_bytes(r.path, r.body, r.content_type, timeout));
 }
 
-ApiReply<std::vector<uint64_t>> FarmApi::heartbeat(uint64_t worker, const std::vector<HeldLease>& held,
-                                                   double timeout) const {
+ApiReply<std::vector<uint64_t>> FarmApi::heartbeat(uint64_t worker, const Heartbeat& heartbeat, double timeout) const {
   return decode<std::vector<uint64_t>>(
-      http_.post_json(worker_path(worker) + "/heartbeat", heartbeat_to_json(held), timeout),
+      http_.post_json(worker_path(worker) + "/heartbeat", heartbeat_to_json(heartbeat), timeout),
       [](const json& j, ApiReply<std::vector<uint64_t>>& out) { out.value = j.at("drop").get<std::vector<uint64_t>>(); });
 }
 

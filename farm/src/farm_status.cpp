@@ -11,7 +11,10 @@ json to_json(const WorkerStatus& w) {
           {"state", w.state},
           {"units_done", w.units_done},
           {"samples_done", w.samples_done},
-          {"samples_per_second", w.samples_per_second}};
+          {"samples_per_second", w.samples_per_second},
+          {"scene_memory_bytes", w.scene_memory_bytes},
+          {"scenes_loaded", w.scenes_loaded},
+          {"memory_budget_bytes", w.memory_budget_bytes}};
 }
 
 json to_json(const Health& h) {

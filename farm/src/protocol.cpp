@@ -381,18 +381,32 @@ bool worker_hello_from_json(const json& j, WorkerHello& out, std::string& error)
   return true;
 }
 
-json heartbeat_to_json(const std::vector<HeldLease>& held) {
+json heartbeat_to_json(const Heartbeat& h) {
   json leases = json::array();
-  for (const HeldLease& l : held) leases.push_back({{"id", l.id}, {"job", l.job}, {"tile", l.tile}, {"pass", l.pass}});
-  return json{{"leases", leases}};
+  for (const HeldLease& l : h.leases) leases.push_back({{"id", l.id}, {"job", l.job}, {"tile", l.tile}, {"pass", l.pass}});
+  json j{{"leases", leases}};
+  if (h.memory) j["memory"] = {{"scene_bytes", h.memory->scene_bytes}, {"scenes", h.memory->scenes}};
+  return j;
 }
 
-bool heartbeat_from_json(const json& j, std::vector<HeldLease>& out, std::string& error) {
+bool heartbeat_from_json(const json& j, Heartbeat& heartbeat, std::string& error) {
   Fields f(j, error, "heartbeat");
-  json leases = json::array();
+  json leases = json::array(), memory;
   f.get("leases", leases);
+  f.get("memory", memory);
   f.finish();
   if (!f.ok()) return false;
+  heartbeat.memory.reset();
+  if (!memory.is_null()) {
+    WorkerMemory m;
+    Fields g(memory, error, "heartbeat memory");
+    g.get("scene_bytes", m.scene_bytes, true);
+    g.get("scenes", m.scenes, true);
+    g.finish();
+    if (!g.ok()) return false;
+    heartbeat.memory = m;
+  }
+  std::vector<HeldLease>& out = heartbeat.leases;
   if (!leases.is_array() || leases.size() > kMaxHeldLeases) {
     error = "heartbeat: 'leases' must be an array of at most " + std::to_string(kMaxHeldLeases) + " leases";
     return false;

@@ -472,6 +472,11 @@ std::string Coordinator::metrics() {
     out += "tessera_worker_samples_per_second{worker=\"" + std::to_string(id) + "\",name=\"" + escape_label(w.row.name) +
            "\"} " + std::to_string(w.render_seconds > 0 ? double(w.samples_done) / w.render_seconds : 0.0) + "\n";
 
+  out += metric_header("tessera_worker_scene_memory_bytes", "gauge", "Bytes of scenes loaded in a worker's cache, per worker.");
+  for (auto& [id, w] : s.workers)
+    out += "tessera_worker_scene_memory_bytes{worker=\"" + std::to_string(id) + "\",name=\"" + escape_label(w.row.name) +
+           "\"} " + std::to_string(w.memory.scene_bytes) + "\n";
+
   out += s.lease_wait.render("tessera_lease_wait_seconds", "Time a lease request waited (long poll) before its answer.");
   out += s.upload_seconds.render("tessera_upload_seconds", "Time to verify and commit an uploaded tile result.");
   out += metric_header("tessera_bytes_total", "counter", "Payload bytes received (bundles, results) and sent (leases, bundles, images).");

@@ -43,6 +43,7 @@ struct WorkerInfo {
   WorkerState state = WorkerState::Idle;
   uint64_t units_done = 0, samples_done = 0;
   double render_seconds = 0;
+  WorkerMemory memory;  // as its last heartbeat reported it
 };
 
 struct Coordinator::Impl {

@@ -197,15 +197,16 @@ Result<std::optional<Lease>> Coordinator::lease(uint64_t worker, double wait_sec
   return std::optional<Lease>();
 }
 
-Result<std::vector<uint64_t>> Coordinator::heartbeat(uint64_t worker, const std::vector<HeldLease>& held) {
+Result<std::vector<uint64_t>> Coordinator::heartbeat(uint64_t worker, const Heartbeat& heartbeat) {
   Impl& s = *impl_;
   s.adopt_worker(worker);
   std::lock_guard<std::mutex> lock(s.mu);
   WorkerInfo* w = s.find_worker(worker);
   if (!w) return unknown_worker(worker);
   s.saw_worker(worker, *w);
+  if (heartbeat.memory) w->memory = *heartbeat.memory;
   std::vector<uint64_t> drop;
-  for (const HeldLease& l : held)
+  for (const HeldLease& l : heartbeat.leases)
     if (!s.keep_lease(worker, l)) drop.push_back(l.id);
   s.update_busy(worker, *w);
   return drop;
@@ -451,7 +452,8 @@ Result<std::vector<WorkerStatus>> Coordinator::list_workers() {
   std::vector<WorkerStatus> list;
   for (auto& [id, w] : s.workers)
     list.push_back({id, w.row.name, worker_state_name(w.state), int(w.row.threads), w.units_done, w.samples_done,
-                    w.render_seconds > 0 ? double(w.samples_done) / w.render_seconds : 0.0});
+                    w.render_seconds > 0 ? double(w.samples_done) / w.render_seconds : 0.0, w.memory.scene_bytes,
+                    w.memory.scenes, w.row.memory});
   return list;
 }
 

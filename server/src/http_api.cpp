@@ -289,11 +289,11 @@ void install_routes(httplib::Server& http, Coordinator& c, uint64_t max_upload_b
     uint64_t id;
     json body;
     if (!parse_id(req, 1, id, res) || !parse_body(req, res, body)) return;
-    std::vector<HeldLease> held;
+    Heartbeat heartbeat;
     std::string error;
-    if (!heartbeat_from_json(body, held, error))
+    if (!heartbeat_from_json(body, heartbeat, error))
       return send_error(res, make_error(Code::BadRequest, "bad_heartbeat", error));
-    Result<std::vector<uint64_t>> drop = c.heartbeat(id, held);
+    Result<std::vector<uint64_t>> drop = c.heartbeat(id, heartbeat);
     if (!drop.ok()) return send_error(res, drop.status);
     send_json(res, 200, json{{"drop", drop.value}});
   });

@@ -319,7 +319,9 @@
     const row = (w) => el('tr', { dataset: { workerId: w.id, state: w.state } },
       el('td', { className: 'num' }, `#${w.id}`), el('td', {}, w.name), el('td', {}, badge(w.state)),
       el('td', { className: 'num' }, w.threads), el('td', { className: 'num' }, count(w.units_done)),
-      el('td', { className: 'num' }, rate(w.samples_per_second)));
+      el('td', { className: 'num' }, rate(w.samples_per_second)),
+      el('td', { className: 'num', title: `${w.scenes_loaded || 0} scene(s) loaded, budget ${bytes(w.memory_budget_bytes)}` },
+        bytes(w.scene_memory_bytes)));
     tbody.replaceChildren(...[...workers].sort((a, b) => a.id - b.id).map(row));
     $('workers-empty').hidden = workers.length > 0;
     $('workers-empty').textContent = 'No workers registered.';

@@ -294,6 +294,9 @@ def run(args, tmp):
         # The worker's speed is known once it has rendered something.
         wait_for(driver, 20, "the worker's speed", lambda d: any(
             "samples/s" in r.text for r in d.find_elements(By.CSS_SELECTOR, "#workers tbody tr")))
+        # And the memory its loaded scene takes, from its heartbeats.
+        wait_for(driver, 20, "the worker's scene memory", lambda d: any(
+            "KiB" in r.text or "MiB" in r.text for r in d.find_elements(By.CSS_SELECTOR, "#workers tbody tr")))
         driver.execute_script("window.scrollTo(0, 0)")
         Path(args.screenshot).parent.mkdir(parents=True, exist_ok=True)
         check(driver.save_screenshot(args.screenshot), "the screenshot was not saved")

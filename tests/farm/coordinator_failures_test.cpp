@@ -86,7 +86,7 @@ TEST(CoordinatorFailures, AfterARestartLeasesInFlightWaitForTheirWorkers) {
   // Its worker reports it and delivers it: nothing was rendered twice.
   HeldLease h{held["id"].get<uint64_t>(), held["job"].get<uint64_t>(), held["tile"].get<uint32_t>(),
               held["pass"].get<uint32_t>()};
-  json hb = {{"drop", c.heartbeat(w, {h}).value}};
+  json hb = {{"drop", c.heartbeat(w, Heartbeat{{h}, std::nullopt}).value}};
   EXPECT_TRUE(hb["drop"].empty()) << hb.dump();
   ASSERT_TRUE(c.upload_result(w, held["id"], render_unit(held, tiny.scene(), 1)).ok());
   st = to_json(c.job_status(id).value);

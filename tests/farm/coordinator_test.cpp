@@ -163,6 +163,22 @@ TEST(Coordinator, DrainedWorkerGetsNoMoreWork) {
   EXPECT_EQ(c.drain_worker(77).code, server::Code::NotFound);
 }
 
+TEST(Coordinator, WorkersShowTheSceneMemoryTheirHeartbeatsReport) {
+  TempDir dir;
+  Coordinator c(options(dir));
+  const uint64_t a = add_worker(c, "a");
+  auto status = [&] { return to_json(c.list_workers().value.at(0)); };
+  EXPECT_EQ(status()["scene_memory_bytes"], 0);
+  ASSERT_TRUE(c.heartbeat(a, Heartbeat{{}, WorkerMemory{uint64_t(3) << 30, 2}}).ok());
+  EXPECT_EQ(status()["scene_memory_bytes"], uint64_t(3) << 30);
+  EXPECT_EQ(status()["scenes_loaded"], 2);
+  // A heartbeat without the report (an older worker) keeps the last one.
+  ASSERT_TRUE(c.heartbeat(a, Heartbeat{}).ok());
+  EXPECT_EQ(status()["scenes_loaded"], 2);
+  EXPECT_NE(c.metrics().find("tessera_worker_scene_memory_bytes{worker=\"" + std::to_string(a) + "\",name=\"a\"} 3221225472"),
+            std::string::npos);
+}
+
 TEST(Coordinator, ABrokenDataDirectoryIsAClearError) {
   TempDir dir;
   std::filesystem::create_directories(dir.path / "data");

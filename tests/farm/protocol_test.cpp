@@ -165,24 +165,32 @@ TEST(Protocol, LeaseBytesCountedFromTheJobPartAreExact) {
 }
 
 TEST(Protocol, HeartbeatsRoundTripAndAreStrict) {
-  const std::vector<HeldLease> held = {{31, 1, 5, 2}, {32, 1, 6, 2}};
-  std::vector<HeldLease> back;
+  Heartbeat held;
+  held.leases = {{31, 1, 5, 2}, {32, 1, 6, 2}};
+  held.memory = WorkerMemory{uint64_t(5) << 32, 3};
+  Heartbeat back;
   std::string error;
   ASSERT_TRUE(heartbeat_from_json(heartbeat_to_json(held), back, error)) << error;
-  ASSERT_EQ(back.size(), 2u);
-  EXPECT_EQ(back[1].id, 32u);
-  EXPECT_EQ(back[1].tile, 6u);
-  ASSERT_TRUE(heartbeat_from_json(json::object(), back, error)) << "no leases held";
-  EXPECT_TRUE(back.empty());
+  ASSERT_EQ(back.leases.size(), 2u);
+  EXPECT_EQ(back.leases[1].id, 32u);
+  EXPECT_EQ(back.leases[1].tile, 6u);
+  ASSERT_TRUE(back.memory.has_value());
+  EXPECT_EQ(back.memory->scene_bytes, uint64_t(5) << 32);
+  EXPECT_EQ(back.memory->scenes, 3u);
+  ASSERT_TRUE(heartbeat_from_json(json::object(), back, error)) << "no leases held, no memory reported";
+  EXPECT_TRUE(back.leases.empty());
+  EXPECT_FALSE(back.memory.has_value());
   auto refused = [&](const json& j, const std::string& why) {
     std::string e;
-    std::vector<HeldLease> out;
+    Heartbeat out;
     EXPECT_FALSE(heartbeat_from_json(j, out, e)) << j.dump().substr(0, 80);
     EXPECT_NE(e.find(why), std::string::npos) << e;
   };
   refused(json::array(), "expected a JSON object");
   refused(json{{"leases", json::array()}, {"junk", 1}}, "unknown field 'junk'");
   refused(json{{"leases", "x"}}, "'leases' must be an array");
+  refused(json{{"memory", {{"scene_bytes", -1}, {"scenes", 0}}}}, "'scene_bytes' must be an integer in range");
+  refused(json{{"memory", {{"scenes", 1}}}}, "missing field 'scene_bytes'");
   refused(json{{"leases", {{{"id", 1}, {"job", 1}, {"tile", 0}}}}}, "missing field 'pass'");
   refused(json{{"leases", {{{"id", -1}, {"job", 1}, {"tile", 0}, {"pass", 0}}}}}, "field 'id'");
   refused(json{{"leases", {{{"id", 1}, {"job", 1}, {"tile", 0}, {"pass", 0}, {"extra", 0}}}}}, "unknown field 'extra'");

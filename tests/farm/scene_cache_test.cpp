@@ -53,9 +53,14 @@ TEST(SceneCache, LoadsOnceAndEvictsLeastRecentlyUsed) {
     EXPECT_EQ(cache.downloads(), 0u);
   }
   farm::SceneCache roomy(dir.path.string(), uint64_t(1) << 32);
-  (void)roomy.get(a, nowhere);
-  (void)roomy.get(b, nowhere);
+  const auto sa = roomy.get(a, nowhere), sb = roomy.get(b, nowhere);
   EXPECT_EQ(roomy.loaded_scenes(), 2u);
+  // What the worker reports in its heartbeats: each scene as Scene::memory counts it.
+  const WorkerMemory m = roomy.memory();
+  EXPECT_EQ(m.scenes, 2u);
+  EXPECT_GT(sa->scene->memory().accel, 0u);
+  EXPECT_EQ(sa->bytes, sa->scene->memory().total());
+  EXPECT_EQ(m.scene_bytes, sa->bytes + sb->bytes);
 }
 
 TEST(SceneCache, FailuresAreReportedAndNotCached) {

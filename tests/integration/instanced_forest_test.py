@@ -3,8 +3,10 @@
 100,000-triangle tree (a billion instanced triangles); the farm renders it on one worker
 (tessera-server without local workers, one tessera-worker, tessera submit --wait) to the same bits
 as `tessera render`, with no NaN or Inf, trees in view, and the worker's peak memory under 4 GB.
-Prints the load and BVH build times the CLI reports."""
+The worker's heartbeats report the scene's memory, which the coordinator shows. Prints the load
+and BVH build times the CLI reports."""
 import argparse
+import json
 import os
 import re
 import resource
@@ -13,6 +15,7 @@ import subprocess
 import sys
 import tempfile
 import time
+import urllib.request
 
 MAX_WORKER_BYTES = 4 << 30
 
@@ -51,6 +54,17 @@ def start_farm(args, tmp):
                                os.path.join(tmp, "cache"), "--poll-wait", "1"],
                               stdout=open(os.path.join(tmp, "worker.log"), "w"), stderr=subprocess.STDOUT)
     return server, worker, url
+
+
+def reported_scene_memory(url):
+    """The worker's scene memory as GET /api/v1/workers shows it, once a heartbeat reported it."""
+    for _ in range(150):
+        with urllib.request.urlopen(url + "/api/v1/workers", timeout=10) as r:
+            workers = json.load(r)["workers"]
+        if workers and workers[0].get("scene_memory_bytes", 0) > 0:
+            return workers[0]
+        time.sleep(0.1)
+    fail("no worker reported its scene memory: %s" % workers)
 
 
 def main():
@@ -92,6 +106,7 @@ def main():
                                capture_output=True, text=True, timeout=600)
             if r.returncode != 0:
                 fail("tessera submit exited %d: %s%s" % (r.returncode, r.stdout[-2000:], r.stderr[-2000:]))
+            worker_status = reported_scene_memory(url)
         finally:
             worker.terminate()
             _, status, usage = os.wait4(worker.pid, 0)
@@ -100,7 +115,11 @@ def main():
         if open(farm, "rb").read() != open(local, "rb").read():
             fail("the farm's image differs from tessera render's")
         peak = usage.ru_maxrss * 1024  # kilobytes on Linux
-        print("forest on one worker: peak resident memory %.0f MB" % (peak / 2**20))
+        reported = worker_status["scene_memory_bytes"]
+        print("forest on one worker: peak resident memory %.0f MB; the worker reports %.1f MB of scene in %d scene(s)"
+              % (peak / 2**20, reported / 2**20, worker_status["scenes_loaded"]))
+        if worker_status["scenes_loaded"] != 1 or not (2**20 < reported < peak):
+            fail("the reported scene memory (%d bytes) is not within the worker's footprint (%d)" % (reported, peak))
         if peak > MAX_WORKER_BYTES:
             fail("the worker peaked at %.1f GB, over 4 GB" % (peak / 2**30))
     print("PASS")

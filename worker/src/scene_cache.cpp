@@ -63,7 +63,7 @@ std::shared_ptr<const CachedScene> SceneCache::load(const Lease& lease, const cl
   LoadedJobScene loaded = load_job_scene(dir.string(), lease.scene_file, lease.settings);
   auto out = std::make_shared<CachedScene>();
   out->scene = std::move(loaded.loaded.scene);
-  out->bytes = uint64_t(out->scene->accel().stats().bytes) + uint64_t(out->scene->num_triangles()) * 64 + (1u << 20);
+  out->bytes = out->scene->memory().total();
   return out;
 }
 
@@ -146,6 +146,20 @@ void SceneCache::evict_locked() {
     entries_.erase(e);
     it = std::prev(lru_.erase(it));
   }
+}
+
+WorkerMemory SceneCache::memory() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  WorkerMemory m;
+  for (auto& [key, e] : entries_) {
+    if (e.scene.wait_for(std::chrono::seconds(0)) != std::future_status::ready) continue;
+    try {
+      m.scene_bytes += e.scene.get()->bytes;
+      ++m.scenes;
+    } catch (const std::exception&) {  // a load that failed holds nothing
+    }
+  }
+  return m;
 }
 
 size_t SceneCache::loaded_scenes() const {

@@ -101,13 +101,14 @@ int Worker::run() {
 }
 
 void Worker::heartbeat_loop() {
-  std::vector<HeldLease> held;
+  Heartbeat beat;
   {
     std::lock_guard<std::mutex> lock(leases_mutex_);
-    for (auto& [id, l] : active_) held.push_back({id, l.job_id, l.tile, l.pass});
+    for (auto& [id, l] : active_) beat.leases.push_back({id, l.job_id, l.tile, l.pass});
   }
+  beat.memory = cache_.memory();
   const uint64_t id = worker_id_;
-  client::ApiReply<std::vector<uint64_t>> r = api_.heartbeat(id, held);
+  client::ApiReply<std::vector<uint64_t>> r = api_.heartbeat(id, beat);
   if (r.http.status == 404) {
     std::lock_guard<std::mutex> lock(register_mutex_);
     if (worker_id_ == id) register_with_server();

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <bit>
 #include <chrono>
+#include <unordered_set>
 
 namespace tessera {
 
@@ -164,6 +165,28 @@ Rgb Scene::transmittance(const Ray& ray, const Medium* medium) const {
     r = continue_ray(r, si, si.t);
     if (!(r.tmax > 0.f)) return tr;
   }
+}
+
+size_t Scene::accel_bytes() const {
+  size_t bytes = accel_.stats().bytes + top_.bytes() + prim_shape_.size() * sizeof(uint32_t);
+  for (const GroupAccel& g : groups_) bytes += g.bvh.stats().bytes + g.prim_shape.size() * sizeof(uint32_t);
+  return bytes;
+}
+
+SceneMemory Scene::memory() const {
+  SceneMemory m;
+  m.accel = accel_bytes();
+  std::unordered_set<const void*> counted;
+  for (const auto& shape : shapes) {
+    if (shape->kind() != Shape::Kind::Mesh) continue;
+    const MeshData& mesh = static_cast<const TriangleMeshShape&>(*shape).mesh();
+    if (!counted.insert(&mesh).second) continue;
+    m.meshes += mesh.positions.size() * sizeof(Vec3) + mesh.normals.size() * sizeof(Vec3) +
+                mesh.uvs.size() * sizeof(Vec2) + mesh.indices.size() * sizeof(uint32_t);
+  }
+  for (const auto& t : textures) m.images += t->memory_bytes(counted);
+  for (const auto& l : lights) m.images += l->memory_bytes();
+  return m;
 }
 
 const Light* Scene::sample_light(const LightSampleContext& ctx, float u, float& pmf) const {

@@ -102,12 +102,6 @@ void Scene::build_instances() {
   top_ = InstanceBvh::build(top);
 }
 
-size_t Scene::accel_bytes() const {
-  size_t bytes = accel_.stats().bytes + top_.bytes() + prim_shape_.size() * sizeof(uint32_t);
-  for (const GroupAccel& g : groups_) bytes += g.bvh.stats().bytes + g.prim_shape.size() * sizeof(uint32_t);
-  return bytes;
-}
-
 void Scene::fill_placed(const Ray& ray, const Hit& hit, SurfaceInteraction& si) const {
   const Placement& p = placements_[hit.inst];
   const GroupAccel& g = groups_[p.group];

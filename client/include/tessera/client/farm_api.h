@@ -70,8 +70,7 @@ class FarmApi {
   /// A long poll of up to `wait` seconds: a lease (200), or none for now (204, value empty).
   ApiReply<std::optional<Lease>> lease(uint64_t worker, double wait, double timeout) const;
   /// The ids among `held` the coordinator no longer wants (cancelled, or delivered by another).
-  ApiReply<std::vector<uint64_t>> heartbeat(uint64_t worker, const std::vector<HeldLease>& held,
-                                            double timeout = 10) const;
+  ApiReply<std::vector<uint64_t>> heartbeat(uint64_t worker, const Heartbeat& heartbeat, double timeout = 10) const;
   /// With `want_next`, the answer also carries the worker's next lease when there is work for it
   /// now (one request and one commit instead of two; no long poll).
   ApiReply<ResultAck> upload_result(uint64_t worker, uint64_t lease, const std::string& tile_result,

@@ -44,6 +44,11 @@ class EnvmapLight final : public Light {
   Rgb le_env(Vec3 d) const override;
   float pdf_env(Vec3 d) const override;
   bool is_infinite() const override { return true; }
+  /// Texels, row tables and the sampling distribution (a float pdf and cdf entry per cell).
+  size_t memory_bytes() const override {
+    return texels_.size() * sizeof(Rgb) + row_cos_.size() * sizeof(double) + inv_cell_solid_angle_.size() * sizeof(float) +
+           texels_.size() * 2 * sizeof(float);
+  }
   /// pi R^2 * integral over the sphere of the luminance (R: scene bounding-sphere radius, 1 before
   /// preprocess): the power that would cross a disk of the scene's cross-section.
   float power() const override;

@@ -62,6 +62,8 @@ class Light {
   virtual bool is_delta() const { return false; }
   /// Total emitted power (an estimate is fine); lights are picked in proportion to it.
   virtual float power() const = 0;
+  /// Bytes of the tables it holds (an environment map's texels and sampling distribution).
+  virtual size_t memory_bytes() const { return 0; }
 
   /// Light hierarchies: where and in which directions this light emits (render/light_bounds.h).
   /// False for lights that cannot say (infinite ones); those are picked with a fixed probability.

@@ -47,6 +47,15 @@ struct IntegratorSettings {
 
 enum class SamplerType { Sobol, Independent };
 
+/// What a loaded scene holds in memory, in bytes (Scene::memory): what a worker's scene cache
+/// budgets for and reports.
+struct SceneMemory {
+  uint64_t accel = 0;   // BVHs: world, shapegroups, moving shapes, the top level
+  uint64_t meshes = 0;  // vertex and index arrays, a mesh shared by shapes counted once
+  uint64_t images = 0;  // textures' texels (shared ones once) and environment maps
+  uint64_t total() const { return accel + meshes + images; }
+};
+
 struct SamplerSettings {
   SamplerType type = SamplerType::Sobol;
   int sample_count = 4;
@@ -125,6 +134,7 @@ class Scene {
   uint64_t num_instanced_triangles() const { return num_instanced_triangles_; }
   /// Bytes of the BVHs: world, groups, moving shapes and the top level over instances.
   size_t accel_bytes() const;
+  SceneMemory memory() const;
   double bvh_build_seconds() const { return bvh_seconds_; }
 
  private:

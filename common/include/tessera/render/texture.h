@@ -4,6 +4,9 @@
 #include "tessera/core/rgb.h"
 #include "tessera/render/interaction.h"
 
+#include <cstddef>
+#include <unordered_set>
+
 namespace tessera {
 
 class Texture {
@@ -16,6 +19,9 @@ class Texture {
   virtual Vec2 eval_1_gradient(const SurfaceInteraction&) const { return {}; }
   /// Mean value over the texture; used to estimate light power and for fallbacks.
   virtual Rgb mean() const = 0;
+  /// Bytes of the data it holds (an image's texels) not yet in `counted`, whose keys it adds, so
+  /// data shared by several textures counts once (Scene::memory).
+  virtual size_t memory_bytes(std::unordered_set<const void*>& counted) const { return 0; }
 };
 
 class ConstantTexture final : public Texture {

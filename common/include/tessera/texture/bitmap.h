@@ -52,6 +52,9 @@ class BitmapTexture final : public Texture {
                 TextureFilter filter = TextureFilter::Bilinear, UvMapping to_uv = {});
 
   Rgb eval(const SurfaceInteraction& si) const override { return lookup(to_uv_.apply(si.uv)); }
+  size_t memory_bytes(std::unordered_set<const void*>& counted) const override {
+    return counted.insert(texels_.get()).second ? texels_->bytes() : 0;
+  }
   float eval_1(const SurfaceInteraction& si) const override;
   /// Derivative of the bilinear interpolation (Mitsuba 0.6's evalGradientBilinear at the finest
   /// level), through to_uv; zero for the nearest filter, as in Mitsuba.

@@ -16,6 +16,9 @@ struct WorkerStatus {
   int threads = 0;
   uint64_t units_done = 0, samples_done = 0;
   double samples_per_second = 0;  // over its render time
+  uint64_t scene_memory_bytes = 0;  // scenes and guides loaded in its cache (heartbeat)
+  uint32_t scenes_loaded = 0;
+  uint64_t memory_budget_bytes = 0;  // what its cache may hold (registration)
 };
 
 nlohmann::json to_json(const WorkerStatus& w);

@@ -139,9 +139,23 @@ struct HeldLease {
 /// A worker never holds more leases than this (one per thread): a longer heartbeat is refused.
 inline constexpr size_t kMaxHeldLeases = 4096;
 
-nlohmann::json heartbeat_to_json(const std::vector<HeldLease>& held);
-/// Strict: {"leases": [{"id", "job", "tile", "pass"}, ...]} and nothing else.
-[[nodiscard]] bool heartbeat_from_json(const nlohmann::json& j, std::vector<HeldLease>& out, std::string& error);
+/// What a worker holds in memory: the scenes (and guides) loaded in its cache, measured as
+/// Scene::memory counts them (BVHs, meshes, images), and how many.
+struct WorkerMemory {
+  uint64_t scene_bytes = 0;
+  uint32_t scenes = 0;
+};
+
+/// A worker's heartbeat: the leases it holds and, from workers that report it, its memory.
+struct Heartbeat {
+  std::vector<HeldLease> leases;
+  std::optional<WorkerMemory> memory;
+};
+
+nlohmann::json heartbeat_to_json(const Heartbeat& h);
+/// Strict: {"leases": [{"id", "job", "tile", "pass"}, ...], "memory": {"scene_bytes", "scenes"}}
+/// (both optional) and nothing else.
+[[nodiscard]] bool heartbeat_from_json(const nlohmann::json& j, Heartbeat& out, std::string& error);
 
 /// A bearer token from a flag, a file or the environment, in that order of precedence: `flag`,
 /// else the first line of `file`, else $`env_var` (empty when none is set). Throws

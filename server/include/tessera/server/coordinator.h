@@ -111,8 +111,9 @@ class Coordinator {
   /// Waits up to `wait_seconds` (bounded by max_poll_wait) for work; nothing when there is none.
   Result<std::optional<Lease>> lease(uint64_t worker, double wait_seconds);
   /// The leases the worker still holds: each is kept alive (or re-adopted after a restart); the
-  /// answer lists those the coordinator no longer wants (to drop).
-  Result<std::vector<uint64_t>> heartbeat(uint64_t worker, const std::vector<HeldLease>& held);
+  /// answer lists those the coordinator no longer wants (to drop). The memory it reports is shown
+  /// in its status until the next heartbeat.
+  Result<std::vector<uint64_t>> heartbeat(uint64_t worker, const Heartbeat& heartbeat);
   /// A tile result (tile_result.h bytes). Accepted once per unit: a duplicate is acknowledged and
   /// dropped. Valid without a live lease too (a worker finishing across a coordinator restart).
   /// Answered once durable. With `next`, the answer also carries the worker's next lease (none

@@ -23,7 +23,7 @@ namespace tessera::farm {
 struct CachedScene {
   std::unique_ptr<Scene> scene;
   std::unique_ptr<const SpatialTree> guide;  // an entry for a guide holds it instead of a scene
-  uint64_t bytes = 0;  // estimate: meshes, BVH, images; or the guide's
+  uint64_t bytes = 0;  // Scene::memory (BVHs, meshes, images), or the guide's
 };
 
 class SceneCache {
@@ -38,6 +38,8 @@ class SceneCache {
   std::shared_ptr<const CachedScene> guide(const Lease& lease, const client::FarmApi& api);
 
   size_t loaded_scenes() const;
+  /// Bytes and number of the scenes and guides loaded now (those still loading not counted).
+  WorkerMemory memory() const;
   /// Number of bundle downloads so far (a test checks each bundle is fetched once).
   uint64_t downloads() const { return downloads_; }
 
