@@ -249,6 +249,35 @@ TEST(SceneBuilder, InstancesComposeTransforms) {
   EXPECT_TRUE(r.unsupported.empty());
 }
 
+TEST(SceneBuilder, ShapegroupsDoNotNestAndTheirMembersDoNotMove) {
+  const std::string nested = std::string(kCamera) + R"(
+<shape type="shapegroup" id="inner"><shape type="sphere"/></shape>
+<shape type="shapegroup" id="outer"><shape type="instance"><ref id="inner"/></shape></shape>
+<shape type="instance"><ref id="outer"/></shape>)";
+  EXPECT_NE(scene_error_of([&] { load(nested); }).find("shapegroups cannot contain instances"), std::string::npos);
+  // A member is shared by every instance, so it cannot move on its own: placed at shutter open.
+  const std::string moving = R"(<sensor type="perspective"><float name="shutterOpen" value="0"/>
+  <float name="shutterClose" value="1"/><film type="hdrfilm"><integer name="width" value="8"/>
+  <integer name="height" value="8"/></film></sensor>
+<shapegroup id="g"><shape type="sphere"><animation name="toWorld">
+  <transform time="0"><translate x="0"/></transform><transform time="1"><translate x="2"/></transform>
+</animation></shape></shapegroup>
+<shape type="instance"><ref id="g"/></shape>)";
+  std::string report;
+  try {
+    load(moving, {}, "0.6.0");
+  } catch (const UnsupportedError& e) {
+    report = e.what();
+  }
+  EXPECT_NE(report.find("a moving shape 'sphere' inside a shapegroup"), std::string::npos) << report;
+  LoadOptions allow;
+  allow.allow_unsupported = true;
+  LoadResult r = load(moving, allow, "0.6.0");
+  ASSERT_EQ(r.scene->shapes.size(), 1u);
+  EXPECT_EQ(r.scene->shapes[0]->motion, nullptr);
+  EXPECT_EQ(static_cast<const SphereShape&>(*r.scene->shapes[0]).center(), Vec3(0.f));
+}
+
 TEST(SceneBuilder, MeshFileIsReadOnceForSeveralShapes) {
   TempDir dir;
   dir.write("tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
