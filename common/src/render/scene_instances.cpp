@@ -36,30 +36,23 @@ void gather_primitives(const std::vector<std::unique_ptr<Shape>>& shapes, const 
 }  // namespace
 
 void Scene::build_instances() {
-  // Groups: the shapegroups by Shape::group, then one per moving shape.
-  uint32_t num_groups = 0;
+  // Groups: the shapegroups (numbered by Shape::group), then one per moving shape in shape order.
+  uint32_t num_shapegroups = 0;
   for (const auto& s : shapes)
-    if (s->group != Shape::kNoGroup) num_groups = std::max(num_groups, s->group + 1);
-  for (const ShapeInstance& in : instances) num_groups = std::max(num_groups, in.group + 1);
-  std::vector<std::vector<uint32_t>> members(num_groups);
-  placements_.clear();
+    if (s->group != Shape::kNoGroup) num_shapegroups = std::max(num_shapegroups, s->group + 1);
+  for (const ShapeInstance& in : instances) num_shapegroups = std::max(num_shapegroups, in.group + 1);
+  std::vector<std::vector<uint32_t>> members(num_shapegroups);
   for (uint32_t si = 0; si < shapes.size(); ++si) {
     const Shape& s = *shapes[si];
     // Emitters on placed shapes would need instanced or time-dependent light sampling; the loader
     // refuses them.
     if (s.is_placed()) TESSERA_CHECK(s.light == nullptr);
     if (s.group != Shape::kNoGroup) members[s.group].push_back(si);
-    if (!s.motion) continue;
-    Placement p;
-    p.group = uint32_t(members.size());
-    p.motion = s.motion.get();
-    members.push_back({si});
-    placements_.push_back(p);
+    if (s.motion) members.push_back({si});
   }
-  const size_t num_moving = placements_.size();
 
+  const uint64_t world_triangles = num_triangles_;
   groups_.assign(members.size(), {});
-  std::vector<Bounds3> group_bounds(members.size());
   std::vector<uint64_t> group_triangles(members.size(), 0);
   for (size_t g = 0; g < members.size(); ++g) {
     std::vector<std::array<Vec3, 3>> triangles;
@@ -68,37 +61,30 @@ void Scene::build_instances() {
     group_triangles[g] = triangles.size();
     num_triangles_ += triangles.size();
     groups_[g].bvh = Bvh::build(std::move(triangles), std::move(spheres));
-    group_bounds[g] = groups_[g].bvh.bounds();
   }
 
-  // Instances first (Hit::inst of a shapegroup's instance is its index in `instances`), then the
-  // moving shapes.
-  std::vector<Placement> placed;
-  placed.reserve(instances.size() + num_moving);
+  // Placements: the instances first (Hit::inst of a shapegroup's instance is its index in
+  // `instances`), then the moving shapes, in the order of their groups.
+  placements_.clear();
   for (const ShapeInstance& in : instances) {
-    Placement p;
-    p.group = in.group;
-    if (in.world_from_object.is_static()) p.world_from_object = in.world_from_object.at(shutter_open);
-    else p.motion = &in.world_from_object;
-    placed.push_back(p);
+    if (in.world_from_object.is_static()) placements_.push_back({in.group, in.world_from_object.at(shutter_open)});
+    else placements_.push_back({in.group, Transform(), &in.world_from_object});
   }
-  placed.insert(placed.end(), placements_.begin(), placements_.end());
-  placements_ = std::move(placed);
+  uint32_t moving_group = num_shapegroups;
+  for (const auto& s : shapes)
+    if (s->motion) placements_.push_back({moving_group++, Transform(), s->motion.get()});
 
   has_motion_ = false;
-  num_instanced_triangles_ = num_triangles_;
+  num_instanced_triangles_ = world_triangles;  // a group's triangles count once per placement
   std::vector<BvhInstance> top;
   top.reserve(placements_.size());
-  for (uint32_t i = 0; i < placements_.size(); ++i) {
-    Placement& p = placements_[i];
-    const Bounds3& b = group_bounds[p.group];
+  for (Placement& p : placements_) {
+    const Bounds3 b = groups_[p.group].bvh.bounds();
     p.world_bounds = p.motion ? p.motion->motion_bounds(b, shutter_open, shutter_close) : p.world_from_object.apply(b);
     has_motion_ = has_motion_ || p.motion != nullptr;
-    if (i < instances.size()) num_instanced_triangles_ += group_triangles[p.group];
+    num_instanced_triangles_ += group_triangles[p.group];
     top.push_back({&groups_[p.group].bvh, p.world_from_object, p.motion, p.world_bounds});
   }
-  // A group's own triangles count only through its instances.
-  for (uint32_t g = 0; g < num_groups; ++g) num_instanced_triangles_ -= group_triangles[g];
   top_ = InstanceBvh::build(top);
 }
 
