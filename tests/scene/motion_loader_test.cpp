@@ -79,7 +79,7 @@ std::string moving(const std::string& close, const std::string& emit = "") {
   return s;
 }
 
-TEST(MotionLoader, MovingSphereBecomesAMotionInstance) {
+TEST(MotionLoader, MovingSphereIsPlacedByTheInstanceBvh) {
   auto scene = load_scene(parse_scene_string(moving("1"), "mem/m.xml"), LoadOptions{}).scene;
   EXPECT_EQ(scene->shutter_close, 1.f);
   ASSERT_EQ(scene->instance_accel().size(), 1u);
