@@ -1,6 +1,6 @@
-// Mitsuba's `bitmap` texture: an image file looked up at the surface's uv, decoded to linear values
-// once per scene (texture/bitmap_prefetch.h, LoadContext::cached_resource) and filtered bilinearly (or nearest) as Mitsuba 0.6's
-// MIPMap does at its finest level.
+// Mitsuba's `bitmap` texture: an image file looked up at the surface's uv, decoded once per scene
+// (texture/bitmap_prefetch.h, LoadContext::cached_resource) and filtered bilinearly (or nearest)
+// as Mitsuba 0.6's MIPMap does at its finest level.
 #include "tessera/texture/bitmap.h"
 
 #include "tessera/scene/load_context.h"
