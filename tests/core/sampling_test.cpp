@@ -1,8 +1,10 @@
+#include "tessera/core/distribution.h"
 #include "tessera/core/hash.h"
 #include "tessera/core/sampling.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace tessera {
@@ -62,6 +64,43 @@ TEST(Distribution1D, EdgesNeverPickEmptyBins) {
   Distribution1D d({0.f, 1.f, 0.f});
   EXPECT_EQ(d.sample_discrete(0.f), 1u);
   EXPECT_EQ(d.sample_discrete(0x1.fffffep-1f), 1u);
+}
+
+// The bin a binary search over the whole cdf picks (the search the guide table replaces), with
+// the cdf summed and normalised as Distribution1D does.
+uint32_t binary_search_bin(const std::vector<float>& w, float u) {
+  std::vector<double> cdf(w.size() + 1, 0.0), f(w.size());
+  for (size_t i = 0; i < w.size(); ++i) {
+    f[i] = std::isfinite(w[i]) && w[i] > 0.f ? double(w[i]) : 0.0;
+    cdf[i + 1] = cdf[i] + f[i];
+  }
+  const double sum = cdf.back();
+  for (size_t i = 1; i <= w.size(); ++i) cdf[i] /= sum;
+  cdf.back() = 1.0;
+  auto it = std::upper_bound(cdf.begin(), cdf.end(), double(u));
+  size_t i = size_t(std::clamp<std::ptrdiff_t>(it - cdf.begin() - 1, 0, std::ptrdiff_t(w.size()) - 1));
+  while (i + 1 < w.size() && f[i] == 0.0) ++i;
+  while (i > 0 && f[i] == 0.0) --i;
+  return uint32_t(i);
+}
+
+TEST(Distribution1D, GuideTableFindsTheBinOfABinarySearch) {
+  Pcg32 rng(11);
+  for (size_t n : {size_t(1), size_t(2), size_t(7), size_t(64), size_t(1000), size_t(2049)}) {
+    // Runs of empty bins and weights spanning twelve orders of magnitude: buckets of the guide
+    // table that hold many bins, none, or a bin boundary exactly.
+    std::vector<float> w(n);
+    for (size_t i = 0; i < n; ++i) w[i] = rng.next_float() < 0.3f ? 0.f : std::exp2(rng.next_float() * 40.f - 20.f);
+    w[n / 2] = 1.f;
+    Distribution1D d(w);
+    std::vector<float> us = {0.f, 0x1.fffffep-1f, 1.f, -0.25f, 0.5f};
+    for (int k = 0; k < 20000; ++k) us.push_back(rng.next_float());
+    for (size_t b = 0; b <= n; ++b) {
+      const float edge = float(double(b) / double(n));
+      us.insert(us.end(), {edge, std::nextafter(edge, 0.f), std::nextafter(edge, 1.f)});
+    }
+    for (float u : us) ASSERT_EQ(d.sample_discrete(u), binary_search_bin(w, u)) << "n " << n << " u " << u;
+  }
 }
 
 TEST(Distribution1D, ContinuousPdfMatchesSampling) {

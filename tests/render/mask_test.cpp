@@ -92,6 +92,37 @@ TEST(Mask, ShadowRaysAreAttenuatedByOneMinusOpacity) {
   EXPECT_EQ(opaque.transmittance(to_first), 0.f);
 }
 
+// Shadow rays through a scene whose cut-outs are all meshes take one any-hit query; with a masked
+// sphere (crossed twice) the scene takes the loop of closest hits. Both give the same product,
+// also past the cap of 64 crossings, where the next cut-out counts as opaque.
+TEST(Mask, OneAnyHitQueryCrossesCutOutsAsTheClosestHitLoopDoes) {
+  auto build = [](bool with_masked_sphere, int layers) {
+    auto scene = std::make_unique<Scene>();
+    const Bsdf* diffuse = add_diffuse(*scene, Rgb(0.5f));
+    for (int k = 0; k < layers; ++k) add_quad(*scene, 1.f + 0.25f * k, 1.f + 0.5f * k, add_mask(*scene, diffuse, 0.02f + 0.013f * (k % 7)));
+    add_quad(*scene, 1.f + 0.25f * layers, 3.f, diffuse);  // an opaque patch behind them
+    if (with_masked_sphere) add_sphere(*scene, Vec3(0.f, 0.f, -50.f), 1.f, false, add_mask(*scene, diffuse, 0.5f));
+    scene->finalize();
+    return scene;
+  };
+  for (int layers : {5, 65}) {
+    auto any_hit = build(false, layers), loop = build(true, layers);
+    Pcg32 rng(19);
+    int attenuated = 0, blocked = 0;
+    for (int i = 0; i < 4000; ++i) {
+      const Vec3 from(2.f * rng.next_float() - 1.f, 2.f * rng.next_float() - 1.f, 0.f);
+      const Vec3 to(16.f * rng.next_float() - 8.f, 16.f * rng.next_float() - 8.f, 1.f + 0.25f * layers + 1.f);
+      const Ray r = spawn_ray_to(from, Vec3(0.f, 0.f, 1.f), to);
+      const float a = any_hit->transmittance(r), b = loop->transmittance(r);
+      ASSERT_NEAR(a, b, 1e-6f * std::max(b, 1e-3f)) << "ray " << i << ", " << layers << " layers";
+      attenuated += a > 0.f && a < 1.f;
+      blocked += a == 0.f;
+    }
+    EXPECT_GT(blocked, 100);  // by the opaque patch, or (65 layers) by the cap
+    if (layers == 5) EXPECT_GT(attenuated, 100);
+  }
+}
+
 TEST(Mask, NanOpacityIsOpaqueAndValuesAreClamped) {
   Scene scene;
   const Bsdf* diffuse = add_diffuse(scene, Rgb(0.5f));

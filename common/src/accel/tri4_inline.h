@@ -9,6 +9,8 @@
 
 #include <emmintrin.h>
 
+#include <type_traits>
+
 namespace tessera::accel_detail {
 
 /// Per-ray broadcasts for the packet test.
@@ -72,11 +74,17 @@ inline int tri4_candidates(const Tri4& p, const WatertightRay4& r, float e1_out[
   return mask;
 }
 
-/// Closest (or, with kAnyHit, any) hit among a packet's triangles with t in (tmin, tmax]; lanes in
-/// order, so ties go to the lower lane as in a scalar loop. Updates tmax and hit on a hit.
-template <int kz, bool kAnyHit>
+/// Any-hit filter that lets every hit block; a filter says whether a candidate hit blocks the ray
+/// (HitFilter::blocks with the ray bound).
+struct NoFilter {
+  constexpr bool operator()(const Hit&) const { return true; }
+};
+
+/// Closest (or, with kAnyHit, any blocking) hit among a packet's triangles with t in (tmin, tmax];
+/// lanes in order, so ties go to the lower lane as in a scalar loop. Updates tmax and hit on a hit.
+template <int kz, bool kAnyHit, class Filter = NoFilter>
 inline bool intersect_tri4(const Tri4& p, const WatertightRay& wr, const WatertightRay4& r4, float tmin,
-                           float& tmax, Hit& hit) {
+                           float& tmax, Hit& hit, const Filter& blocks = {}) {
   float e1[4], e2[4], det[4];
   int mask = tri4_candidates<kz>(p, r4, e1, e2, det);
   bool found = false;
@@ -88,8 +96,11 @@ inline bool intersect_tri4(const Tri4& p, const WatertightRay& wr, const Waterti
     const Vec3 p2(p.v[2][0][l], p.v[2][1][l], p.v[2][2][l]);
     const float t = plane_distance(wr, p0, p1, p2);
     if (!(t > tmin) || t > tmax) continue;
-    if constexpr (kAnyHit) return true;
     const float inv_det = 1.f / det[l];
+    if constexpr (kAnyHit) {
+      if (std::is_same_v<Filter, NoFilter> || blocks(Hit{t, p.prim[l], e1[l] * inv_det, e2[l] * inv_det})) return true;
+      continue;
+    }
     tmax = t;
     hit.t = t;
     hit.prim = p.prim[l];

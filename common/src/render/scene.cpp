@@ -50,6 +50,7 @@ void Scene::finalize() {
                std::any_of(shapes.begin(), shapes.end(), [](const auto& s) { return s->medium_interface; });
   has_masks_ = std::any_of(shapes.begin(), shapes.end(),
                            [](const auto& s) { return s->bsdf && s->bsdf->has_opacity(); });
+  flag_see_through();
   auto t0 = std::chrono::steady_clock::now();
   accel_ = Bvh::build(std::move(triangles), std::move(spheres));
   build_instances();
@@ -130,8 +131,53 @@ bool Scene::intersect(const Ray& ray, SurfaceInteraction& si, bool stop_at_null)
   return true;
 }
 
+void Scene::flag_see_through() {
+  see_through_.clear();
+  if (!has_masks_) return;
+  std::vector<uint64_t> bits((prim_shape_.size() + 63) / 64, 0);
+  for (uint32_t si = 0; si < shapes.size(); ++si) {
+    const Shape& s = *shapes[si];
+    if (!s.bsdf || !s.bsdf->has_opacity()) continue;
+    // A sphere is crossed twice and a placed shape is not in the world BVH: the loop handles those.
+    if (s.is_placed() || s.kind() != Shape::Kind::Mesh) return;
+    for (uint32_t p = shape_first_[si], end = p + uint32_t(s.num_primitives()); p < end; ++p)
+      bits[p >> 6] |= uint64_t(1) << (p & 63);
+  }
+  see_through_ = std::move(bits);
+}
+
+namespace {
+
+/// What a shadow ray crossed so far in one any-hit query through cut-outs (HitFilter's ctx).
+struct MaskCrossings {
+  const Scene* scene;
+  float (*opacity_at)(const Scene&, const Ray&, const Hit&);
+  float tr = 1.f;
+  int crossings = 0;
+  static bool occludes(void* ctx, const Ray& ray, const Hit& hit) {
+    auto& c = *static_cast<MaskCrossings*>(ctx);
+    if (++c.crossings > kMaxMaskCrossings) return true;
+    c.tr *= 1.f - c.opacity_at(*c.scene, ray, hit);
+    return !(c.tr > 0.f);
+  }
+};
+
+}  // namespace
+
 float Scene::transmittance(const Ray& ray) const {
   if (!has_masks_) return occluded(ray) ? 0.f : 1.f;
+  if (!see_through_.empty()) {
+    // Every primitive on the segment is offered once, so the product over the cut-outs is the
+    // one the loop below finds, without a closest-hit query (and a fill) per surface.
+    MaskCrossings c{this, [](const Scene& scene, const Ray& r, const Hit& hit) {
+                      SurfaceInteraction si;
+                      scene.fill(r, hit, si);
+                      return masked_opacity(si);
+                    }};
+    if (accel_.occluded(ray, HitFilter{see_through_.data(), &MaskCrossings::occludes, &c})) return 0.f;
+    if (!top_.empty() && top_.occluded(ray)) return 0.f;
+    return c.tr;
+  }
   Ray r = ray;
   float tr = 1.f;
   SurfaceInteraction si;

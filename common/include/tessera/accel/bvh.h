@@ -89,6 +89,20 @@ struct BvhStats {
   double sah_cost = 0;  // of the wide trees: node visits + packet tests per ray, by area
 };
 
+/// Lets an any-hit query pass through some primitives (cut-outs): `flagged` has a bit per global
+/// primitive (bit p % 64 of word p / 64). A candidate hit on a flagged primitive goes to
+/// `occludes(ctx, ray, hit)`, which decides whether it blocks the ray (and may accumulate what the
+/// ray crossed in ctx); hits on other primitives block. Each primitive the ray crosses within
+/// [tmin, tmax] is offered at most once, in an order fixed by the ray and the tree.
+struct HitFilter {
+  const uint64_t* flagged = nullptr;
+  bool (*occludes)(void* ctx, const Ray& ray, const Hit& hit) = nullptr;
+  void* ctx = nullptr;
+  bool blocks(const Ray& ray, const Hit& hit) const {
+    return !(flagged[hit.prim >> 6] >> (hit.prim & 63) & 1) || occludes(ctx, ray, hit);
+  }
+};
+
 class Bvh {
  public:
   Bvh() = default;
@@ -99,6 +113,8 @@ class Bvh {
   bool intersect(const Ray& ray, Hit& hit) const;
   /// Any hit with t in [ray.tmin, ray.tmax].
   bool occluded(const Ray& ray) const;
+  /// Any hit with t in [ray.tmin, ray.tmax] that `filter` says blocks the ray.
+  bool occluded(const Ray& ray, const HitFilter& filter) const;
 
   Bounds3 bounds() const { return bounds_; }
   BvhStats stats() const;
@@ -112,8 +128,8 @@ class Bvh {
  private:
   /// Both traversals (bvh_traversal.cpp): the triangle tree, then the sphere tree with the closest
   /// distance found so far.
-  template <bool kAnyHit>
-  bool trace(const Ray& ray, Hit& hit) const;
+  template <bool kAnyHit, class Filter>
+  bool trace(const Ray& ray, Hit& hit, const Filter& filter) const;
 
   NodeArray tri_nodes_;
   Tri4Array packets_;

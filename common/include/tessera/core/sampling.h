@@ -30,43 +30,4 @@ inline float power_heuristic(float pdf_a, float pdf_b) {
   return a / (a + b);
 }
 
-/// Piecewise-constant 1D distribution over [0,1) (or over indices for discrete use).
-class Distribution1D {
- public:
-  Distribution1D() = default;
-  /// Negative or non-finite weights count as 0. All-zero weights give a uniform distribution.
-  explicit Distribution1D(const std::vector<float>& weights);
-  size_t size() const { return func_.size(); }
-  /// Sum of the weights (the integral times size()).
-  double total() const { return total_; }
-  /// Discrete sample: index with probability w[i]/total; `pmf` receives it; `u_remapped` is u
-  /// rescaled to [0,1) within the chosen bin, so it can be reused.
-  uint32_t sample_discrete(float u, float* pmf = nullptr, float* u_remapped = nullptr) const;
-  float pmf(uint32_t i) const { return size() ? float(func_[i] / total_norm_) : 0.f; }
-  /// Continuous sample in [0,1); pdf with respect to the unit interval.
-  float sample_continuous(float u, float* pdf, uint32_t* index = nullptr) const;
-  float pdf_continuous(float x) const;
-
- private:
-  std::vector<double> func_;
-  std::vector<double> cdf_;  // size()+1 entries, cdf_[0] = 0, cdf_.back() = 1
-  double total_ = 0, total_norm_ = 1;
-};
-
-/// Piecewise-constant 2D distribution over [0,1)^2: marginal over rows (v), conditional per row (u).
-class Distribution2D {
- public:
-  Distribution2D() = default;
-  /// `weights` is row-major, `width` columns (u) by `height` rows (v).
-  Distribution2D(const std::vector<float>& weights, int width, int height);
-  /// Returns (u, v) in [0,1)^2; pdf with respect to the unit square.
-  Vec2 sample(Vec2 u, float* pdf) const;
-  float pdf(Vec2 uv) const;
-
- private:
-  std::vector<Distribution1D> conditional_;
-  Distribution1D marginal_;
-  int width_ = 0, height_ = 0;
-};
-
 }  // namespace tessera

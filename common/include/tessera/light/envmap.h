@@ -18,7 +18,7 @@
 // image is the same, only the noise differs.
 #pragma once
 
-#include "tessera/core/sampling.h"
+#include "tessera/core/distribution.h"
 #include "tessera/core/transform.h"
 #include "tessera/image/image.h"
 #include "tessera/render/light.h"
@@ -44,10 +44,10 @@ class EnvmapLight final : public Light {
   Rgb le_env(Vec3 d) const override;
   float pdf_env(Vec3 d) const override;
   bool is_infinite() const override { return true; }
-  /// Texels, row tables and the sampling distribution (a float pdf and cdf entry per cell).
+  /// Texels, row tables and the sampling distribution.
   size_t memory_bytes() const override {
     return texels_.size() * sizeof(Rgb) + row_cos_.size() * sizeof(double) + inv_cell_solid_angle_.size() * sizeof(float) +
-           texels_.size() * 2 * sizeof(float);
+           distribution_.memory_bytes();
   }
   /// pi R^2 * integral over the sphere of the luminance (R: scene bounding-sphere radius, 1 before
   /// preprocess): the power that would cross a disk of the scene's cross-section.
@@ -66,7 +66,7 @@ class EnvmapLight final : public Light {
   float pdf_light(Vec3 d) const;
 
   int width_ = 0, height_ = 0;
-  std::vector<Rgb> texels_;        // already multiplied by scale
+  HugeVector<Rgb> texels_;         // already multiplied by scale; huge pages: looked up at random
   std::vector<double> row_cos_;   // cos(theta) at each row, height_ entries
   std::vector<float> inv_cell_solid_angle_;  // per cell row: unit-square pdf -> solid-angle pdf
   Distribution2D distribution_;    // over width_ x (height_ - 1) cells

@@ -147,6 +147,9 @@ class Scene {
   double bvh_seconds_ = 0;
   bool has_masks_ = false;
   bool has_media_ = false;
+  // A bit per world BVH primitive of a shape with opacity, when those are all world meshes: shadow
+  // rays then cross them in one any-hit query (transmittance); otherwise empty.
+  std::vector<uint64_t> see_through_;
   // Placed geometry (scene_instances.cpp): one BVH per group (moving shapes: a group each), the
   // placements and the top level over them.
   struct GroupAccel {
@@ -175,6 +178,7 @@ class Scene {
     return top_.intersect(r, hit) || found;
   }
   void build_instances();
+  void flag_see_through();
   void fill_placed(const Ray& ray, const Hit& hit, SurfaceInteraction& si) const;
 };
 

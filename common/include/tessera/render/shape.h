@@ -12,6 +12,7 @@
 #include "tessera/core/bounds.h"
 #include "tessera/core/hit.h"
 #include "tessera/core/ray.h"
+#include "tessera/core/distribution.h"
 #include "tessera/core/sampling.h"
 #include "tessera/core/vec.h"
 #include "tessera/render/interaction.h"
