@@ -120,14 +120,24 @@ TEST(EnvmapOrientation, ToWorldRotatesTheMap) {
   }
 }
 
-// For MIS: the pdf a sample reports is pdf_env() of its direction, and li is le_env() of it.
+// For MIS: the pdf a sample reports is pdf_env() of its direction, and li is le_env() of it. A
+// sample with its radiance deferred is the same sample, and deferred_li() the same radiance.
 void check_sample_consistency(const EnvmapLight& light, int n, uint64_t seed) {
   Pcg32 rng(seed);
   int pdf_mismatch = 0;
   for (int i = 0; i < n; ++i) {
-    LightSample ls;
+    LightSample ls, deferred;
+    deferred.defer_li = true;
     Vec3 ref(1.f, 2.f, 3.f);
-    ASSERT_TRUE(light.sample_li(ref, {rng.next_float(), rng.next_float()}, ls));
+    const Vec2 u(rng.next_float(), rng.next_float());
+    ASSERT_TRUE(light.sample_li(ref, u, ls));
+    ASSERT_TRUE(light.sample_li(ref, u, deferred));
+    ASSERT_FALSE(ls.li_deferred);
+    ASSERT_TRUE(deferred.li_deferred);
+    ASSERT_EQ(deferred.li, Rgb(0.f)) << "a deferred sample does not look its radiance up";
+    ASSERT_EQ(light.deferred_li(deferred), ls.li) << i;
+    ASSERT_EQ(deferred.wi, ls.wi);
+    ASSERT_EQ(deferred.pdf, ls.pdf);
     ASSERT_GT(ls.pdf, 0.f);
     ASSERT_TRUE(std::isfinite(ls.pdf));
     ASSERT_NEAR(length(ls.wi), 1.f, 1e-5f);

@@ -138,7 +138,13 @@ bool EnvmapLight::sample_li(Vec3 ref_p, Vec2 u, LightSample& out) const {
 
   Vec3 wi = to_world(d_light);
   float r = std::max({radius_, length(ref_p - center_), 1e-3f});
-  out.li = lookup(Vec2(float(u_tex >= 1.0 ? u_tex - 1.0 : u_tex), v_tex));
+  const Vec2 uv(float(u_tex >= 1.0 ? u_tex - 1.0 : u_tex), v_tex);
+  if (out.defer_li) {
+    out.li_uv = uv;
+    out.li_deferred = true;
+  } else {
+    out.li = lookup(uv);
+  }
   out.wi = wi;
   out.p_light = ref_p + wi * (2.f * r);
   out.n_light = Vec3(0.f);

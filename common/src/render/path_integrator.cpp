@@ -283,8 +283,9 @@ class PathIntegrator final : public Integrator {
     const bool bsdf_only = s_.strategy == SamplingStrategy::Bsdf;
     if (bsdf_only && light && !light->is_delta()) return {};
     LightSample ls;
+    ls.defer_li = true;  // most samples of an interior's sky are occluded
     if (!light || !(pmf > 0.f) || !light->sample_li(v.p, u_light, ls)) return {};
-    if (!(ls.pdf > 0.f) || ls.li.is_black()) return {};
+    if (!(ls.pdf > 0.f) || (!ls.li_deferred && ls.li.is_black())) return {};
     if (bsdf_only && !ls.delta) return {};
     Rgb f;
     float scatter_pdf = 0.f;
@@ -308,9 +309,10 @@ class PathIntegrator final : public Integrator {
     ++counters.shadow_rays;
     const Rgb tr = volumetric_ ? scene.transmittance(shadow, shadow_medium) : Rgb(scene.transmittance(shadow));
     if (tr.is_black()) return {};
+    const Rgb li = ls.li_deferred ? light->deferred_li(ls) : ls.li;
     float light_pdf = ls.pdf * pmf;
     float w = ls.delta || !mis ? 1.f : power_heuristic(light_pdf, scatter_pdf);
-    return f * ls.li * tr * (w / light_pdf);
+    return f * li * tr * (w / light_pdf);
   }
 
   IntegratorSettings s_;

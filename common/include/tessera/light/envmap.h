@@ -41,6 +41,7 @@ class EnvmapLight final : public Light {
 
   void preprocess(const Bounds3& scene_bounds) override;
   bool sample_li(Vec3 ref_p, Vec2 u, LightSample& out) const override;
+  Rgb deferred_li(const LightSample& s) const override { return lookup(s.li_uv); }
   Rgb le_env(Vec3 d) const override;
   float pdf_env(Vec3 d) const override;
   bool is_infinite() const override { return true; }

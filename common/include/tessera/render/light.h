@@ -2,7 +2,10 @@
 //
 // sample_li() samples a direction from a reference point towards the light. Its `pdf` is with
 // respect to SOLID ANGLE at the reference point; for delta lights (point) `pdf` is 1 and `delta`
-// is set. `li` is the radiance arriving (not divided by the pdf).
+// is set. `li` is the radiance arriving (not divided by the pdf). A caller that traces a shadow
+// ray first may set `defer_li`: a light whose radiance costs memory traffic (an environment map's
+// texels) then leaves `li` unset, sets `li_deferred`, and deferred_li() gives it, so an occluded
+// sample never pays for it. The radiance is the same either way.
 // Area lights and environment lights can also be hit by BSDF-sampled rays: le()/le_env() give the
 // emitted radiance, and pdf_li()/pdf_env() the solid-angle density sample_li() would have had, for
 // multiple importance sampling.
@@ -32,6 +35,9 @@ struct LightSample {
   float dist = kInfinity;  // distance to p_light; kInfinity for infinite lights
   float pdf = 0.f;
   bool delta = false;
+  bool defer_li = false;    // in: the caller asks deferred_li() for li when li_deferred is set
+  bool li_deferred = false;
+  Vec2 li_uv;               // where deferred_li() looks the radiance up (the light's own map)
 };
 
 /// Where a light is sampled from: the shading point and, on surfaces, its (shading-side) normal;
@@ -47,6 +53,8 @@ class Light {
   /// Called once after the scene geometry is known (infinite lights need its bounds).
   virtual void preprocess(const Bounds3& scene_bounds) {}
   virtual bool sample_li(Vec3 ref_p, Vec2 u, LightSample& out) const = 0;
+  /// The radiance of a sample whose li sample_li() deferred.
+  virtual Rgb deferred_li(const LightSample& s) const { return s.li; }
 
   /// Area lights: radiance leaving the hit point `si` in direction `w` (world).
   virtual Rgb le(const SurfaceInteraction& si, Vec3 w) const { return {}; }
