@@ -95,10 +95,13 @@ TEST(Distribution1D, GuideTableFindsTheBinOfABinarySearch) {
     Distribution1D d(w);
     std::vector<float> us = {0.f, 0x1.fffffep-1f, 1.f, -0.25f, 0.5f};
     for (int k = 0; k < 20000; ++k) us.push_back(rng.next_float());
-    for (size_t b = 0; b <= n; ++b) {
-      const float edge = float(double(b) / double(n));
-      us.insert(us.end(), {edge, std::nextafter(edge, 0.f), std::nextafter(edge, 1.f)});
-    }
+    // The guide's bucket edges and the bins' edges, and their float neighbours.
+    const uint32_t k = CdfTable::buckets(uint32_t(n));
+    for (size_t b = 0; b <= n; ++b)
+      for (double edge_d : {double(b) / double(n), double(std::min<size_t>(b, k)) / double(k)}) {
+        const float edge = float(edge_d);
+        us.insert(us.end(), {edge, std::nextafter(edge, 0.f), std::nextafter(edge, 1.f)});
+      }
     for (float u : us) ASSERT_EQ(d.sample_discrete(u), binary_search_bin(w, u)) << "n " << n << " u " << u;
   }
 }

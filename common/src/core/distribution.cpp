@@ -28,8 +28,9 @@ double CdfTable::fill(const float* weights, uint32_t n, CdfEntry* e, uint32_t* g
     total_norm = double(n);
   }
   if (n > 0) e[n].cdf = 1.0;
-  for (uint32_t b = 0, i = 0; n > 0 && b <= n; ++b) {
-    const double edge = double(b) / double(n);
+  const uint32_t k = buckets(n);
+  for (uint32_t b = 0, i = 0; n > 0 && b <= k; ++b) {
+    const double edge = double(b) / double(k);
     while (i < n && e[i + 1].cdf <= edge) ++i;
     guide[b] = i;
   }
@@ -41,11 +42,12 @@ uint32_t CdfTable::sample_discrete(float u, float* pmf_out, float* u_remapped) c
     if (pmf_out) *pmf_out = 0.f;
     return 0;
   }
-  // u * n is exact in double (24-bit mantissa times n < 2^29), so bucket b satisfies
-  // b / n <= u < (b + 1) / n, and rounding b / n to double is monotonic: the largest i with
+  // u * K is exact in double (24-bit mantissa times K < 2^29), so bucket b satisfies
+  // b / K <= u < (b + 1) / K, and rounding b / K to double is monotonic: the largest i with
   // cdf_i <= u lies in [guide[b], guide[b + 1]].
-  const double x = double(u) * double(n);
-  const uint32_t b = x > 0.0 ? uint32_t(std::min(x, double(n - 1))) : 0;
+  const uint32_t k = buckets(n);
+  const double x = double(u) * double(k);
+  const uint32_t b = x > 0.0 ? uint32_t(std::min(x, double(k - 1))) : 0;
   const CdfEntry* first = entries + guide[b] + 1;
   const CdfEntry* last = entries + guide[b + 1] + 1;
   const CdfEntry* it = std::upper_bound(first, last, double(u), [](double v, const CdfEntry& e) { return v < e.cdf; });
@@ -83,30 +85,30 @@ float CdfTable::pdf_continuous(float x) const {
 Distribution1D::Distribution1D(const std::vector<float>& weights) {
   const uint32_t n = uint32_t(weights.size());
   entries_.resize(size_t(n) + 1);
-  guide_.resize(size_t(n) + 1);
+  guide_.resize(size_t(CdfTable::buckets(n)) + 1);
   table_ = {entries_.data(), guide_.data(), n, 1};
   total_ = CdfTable::fill(weights.data(), n, entries_.data(), guide_.data(), table_.total_norm);
 }
 
 Distribution2D::Distribution2D(const std::vector<float>& weights, int width, int height)
     : width_(width), height_(height) {
-  const size_t stride = size_t(width) + 1;
+  const size_t stride = size_t(width) + 1, guide_stride = size_t(CdfTable::buckets(uint32_t(width))) + 1;
   entries_.resize(stride * size_t(height));
-  guide_.resize(stride * size_t(height));
+  guide_.resize(guide_stride * size_t(height));
   row_norm_.resize(size_t(height));
   // A row with no weight keeps marginal weight 0 (its uniform fallback is never chosen).
   std::vector<float> row_sums(static_cast<size_t>(height));
   for (int y = 0; y < height; ++y) {
-    const size_t at = size_t(y) * stride;
-    row_sums[size_t(y)] = float(CdfTable::fill(weights.data() + size_t(y) * size_t(width), uint32_t(width),
-                                               entries_.data() + at, guide_.data() + at, row_norm_[size_t(y)]));
+    row_sums[size_t(y)] =
+        float(CdfTable::fill(weights.data() + size_t(y) * size_t(width), uint32_t(width), entries_.data() + size_t(y) * stride,
+                             guide_.data() + size_t(y) * guide_stride, row_norm_[size_t(y)]));
   }
   marginal_ = Distribution1D(row_sums);
 }
 
 CdfTable Distribution2D::row(size_t y) const {
-  const size_t at = y * (size_t(width_) + 1);
-  return {entries_.data() + at, guide_.data() + at, uint32_t(width_), row_norm_[y]};
+  const size_t guide_stride = size_t(CdfTable::buckets(uint32_t(width_))) + 1;
+  return {entries_.data() + y * (size_t(width_) + 1), guide_.data() + y * guide_stride, uint32_t(width_), row_norm_[y]};
 }
 
 Vec2 Distribution2D::sample(Vec2 u, float* pdf) const {

@@ -1,10 +1,11 @@
 // Tabulated piecewise-constant distributions, sampled by inverting their CDF (so stratified
 // numbers stay stratified). Every pdf here is stated with its measure.
 //
-// The tables of a distribution (a CDF entry and a guide slot per bin) sit in flat arrays: all rows
-// of a Distribution2D share one pair, and arrays of 2 MiB or more are backed by huge pages. An
-// environment map's rows are too large for the caches, so what a sample costs is the cache lines
-// (and pages) it touches: a guide slot, then the one or two entries of its bucket.
+// The tables of a distribution (a CDF entry per bin, a guide slot per few bins) sit in flat arrays:
+// all rows of a Distribution2D share one pair, and arrays of 2 MiB or more are backed by huge
+// pages. An environment map's entries are too large for the caches, so what a sample costs is the
+// cache lines (and pages) it touches: a guide slot (small enough to stay cached), then the one or
+// two lines of entries of its bucket.
 #pragma once
 
 #include "tessera/core/huge_page_allocator.h"
@@ -24,16 +25,24 @@ struct CdfEntry {
 };
 
 /// A view of one distribution's tables (private to the distributions, exposed for their tests):
-/// n + 1 entries and n + 1 guide slots, guide[b] = the largest i with cdf_i <= b / n. A sample u in
-/// bucket b = floor(u n) has its bin in [guide[b], guide[b + 1]], so the search is a few entries
-/// long and finds exactly the bin a binary search over the whole CDF finds.
+/// n + 1 entries and K + 1 guide slots (K = buckets(n)), guide[b] = the largest i with
+/// cdf_i <= b / K. A sample u in bucket b = floor(u K) has its bin in [guide[b], guide[b + 1]], so
+/// the search is a few entries long and finds exactly the bin a binary search over the whole CDF
+/// finds.
 struct CdfTable {
   const CdfEntry* entries = nullptr;
   const uint32_t* guide = nullptr;
   uint32_t n = 0;
   double total_norm = 1;  // the sum the weights are divided by (n for the uniform fallback)
 
-  /// Fills entries[0..n] and guide[0..n] from n weights; returns the sum of the sanitised weights.
+  /// Guide buckets for n bins: one per kBinsPerBucket, so that an environment map's guide slots
+  /// (a few MB) stay in cache while its entries (tens of MB) do not; a bucket of a smooth row then
+  /// spans one cache line of entries.
+  static constexpr uint32_t kBinsPerBucket = 8;
+  static uint32_t buckets(uint32_t n) { return n == 0 ? 0 : (n + kBinsPerBucket - 1) / kBinsPerBucket; }
+
+  /// Fills entries[0..n] and guide[0..buckets(n)] from n weights; returns the sum of the sanitised
+  /// weights.
   static double fill(const float* weights, uint32_t n, CdfEntry* entries, uint32_t* guide, double& total_norm);
   uint32_t sample_discrete(float u, float* pmf, float* u_remapped) const;
   float sample_continuous(float u, float* pdf, uint32_t* index) const;
@@ -88,7 +97,7 @@ class Distribution2D {
   CdfTable row(size_t y) const;
 
   HugeVector<CdfEntry> entries_;  // (width + 1) per row
-  HugeVector<uint32_t> guide_;    // (width + 1) per row
+  HugeVector<uint32_t> guide_;    // CdfTable::buckets(width) + 1 per row
   std::vector<double> row_norm_;
   Distribution1D marginal_;
   int width_ = 0, height_ = 0;
