@@ -31,8 +31,14 @@ inline uint32_t laine_karras_permutation(uint32_t x, uint32_t seed) {
 
 // Second Sobol dimension: direction numbers v_1 = 1/2, v_{k+1} = v_k ^ (v_k >> 1) (the Pascal
 // matrix mod 2). Shuffled indices use all 32 bits, so the matrix-vector product is done a byte
-// at a time through tables rather than bit by bit.
-constexpr std::array<std::array<uint32_t, 256>, 4> make_dim1_tables() {
+// at a time through tables rather than bit by bit. With `reversed`, the tables hold the products'
+// bit reversals (what the Owen scramble works on), which saves a reversal per sample.
+constexpr uint32_t reverse_bits_slow(uint32_t x) {
+  uint32_t r = 0;
+  for (int b = 0; b < 32; ++b) r |= ((x >> b) & 1u) << (31 - b);
+  return r;
+}
+constexpr std::array<std::array<uint32_t, 256>, 4> make_dim1_tables(bool reversed) {
   std::array<uint32_t, 32> v{};
   v[0] = 0x80000000u;
   for (int k = 1; k < 32; ++k) v[size_t(k)] = v[size_t(k - 1)] ^ (v[size_t(k - 1)] >> 1);
@@ -42,15 +48,17 @@ constexpr std::array<std::array<uint32_t, 256>, 4> make_dim1_tables() {
       uint32_t r = 0;
       for (int j = 0; j < 8; ++j)
         if (b & (1u << j)) r ^= v[size_t(8 * byte + j)];
-      t[size_t(byte)][b] = r;
+      t[size_t(byte)][b] = reversed ? reverse_bits_slow(r) : r;
     }
   return t;
 }
-constexpr auto kDim1 = make_dim1_tables();
+constexpr auto kDim1 = make_dim1_tables(false);
+constexpr auto kDim1Reversed = make_dim1_tables(true);
 
-inline uint32_t sobol_dim1(uint32_t i) {
-  return kDim1[0][i & 0xFFu] ^ kDim1[1][(i >> 8) & 0xFFu] ^ kDim1[2][(i >> 16) & 0xFFu] ^ kDim1[3][i >> 24];
+inline uint32_t byte_table_product(const std::array<std::array<uint32_t, 256>, 4>& t, uint32_t i) {
+  return t[0][i & 0xFFu] ^ t[1][(i >> 8) & 0xFFu] ^ t[2][(i >> 16) & 0xFFu] ^ t[3][i >> 24];
 }
+inline uint32_t sobol_dim1(uint32_t i) { return byte_table_product(kDim1, i); }
 
 // Owen scramble of a 32-bit fixed-point coordinate.
 inline uint32_t owen_scramble(uint32_t x, uint32_t seed) {
@@ -71,6 +79,7 @@ void Sampler::start_pixel_sample(Vec2i pixel, uint32_t index) {
     pixel_hash_ = hash_values(uint64_t(uint32_t(pixel.x)), uint32_t(pixel.y), seed_);
   }
   index_ = index;
+  reversed_index_ = sobol::reverse_bits(index);
   dim_ = 0;
   if (type_ == SamplerType::Independent) sample_hash_ = hash_combine(pixel_hash_, index);
 }
@@ -86,7 +95,7 @@ float Sampler::next_1d() {
     bits = uint32_t(hash_combine(sample_hash_, dim_) >> 32);
   } else {
     uint64_t h = hash_combine(pixel_hash_, dim_);
-    uint32_t x = sobol::laine_karras_permutation(sobol::reverse_bits(index_), uint32_t(h));
+    uint32_t x = sobol::laine_karras_permutation(reversed_index_, uint32_t(h));
     bits = sobol::owen_scramble(x, uint32_t(h >> 32));
   }
   dim_ += 1;
@@ -103,10 +112,12 @@ Vec2 Sampler::next_2d() {
     uint64_t h = hash_combine(pixel_hash_, dim_);
     uint32_t h2 = uint32_t(mix64(h ^ 0x5851f42d4c957f2dULL));
     // One shared index shuffle keeps the pair a (0,2)-sequence; separate scrambles per axis.
-    uint32_t x = sobol::laine_karras_permutation(sobol::reverse_bits(index_), uint32_t(h));
+    uint32_t x = sobol::laine_karras_permutation(reversed_index_, uint32_t(h));
     uint32_t shuffled_index = sobol::reverse_bits(x);
-    bx = sobol::owen_scramble(x, uint32_t(h >> 32));
-    by = sobol::owen_scramble(sobol::sobol_dim1(shuffled_index), h2);
+    // owen_scramble(v, s) = reverse(permute(reverse(v), s)), with both inner reversals known.
+    bx = sobol::reverse_bits(sobol::laine_karras_permutation(shuffled_index, uint32_t(h >> 32)));
+    by = sobol::reverse_bits(
+        sobol::laine_karras_permutation(sobol::byte_table_product(sobol::kDim1Reversed, shuffled_index), h2));
   }
   dim_ += 2;
   return {bits_to_unit_float(bx), bits_to_unit_float(by)};

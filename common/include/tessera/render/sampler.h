@@ -66,6 +66,7 @@ class Sampler {
   uint64_t pixel_hash_ = 0;   // hash(pixel, seed), cached across the samples of a pixel
   uint64_t sample_hash_ = 0;  // hash(pixel, index, seed), for the independent sampler
   uint32_t index_ = 0;
+  uint32_t reversed_index_ = 0;  // index_ with its bits reversed, where the Sobol shuffle starts
   uint32_t dim_ = 0;
 };
 
