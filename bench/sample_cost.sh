@@ -10,21 +10,12 @@
 # A missing scene is an error, never a skip. Both builds render each scene once, untimed, first.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-[ $# -eq 2 ] || { echo "usage: bench/sample_cost.sh OLD_BUILD_DIR NEW_BUILD_DIR" >&2; exit 2; }
-old=$1/cli/tessera
-new=$2/cli/tessera
-shared=../shared
+. bench/compare_builds.sh
 scenes=(${SC_SCENES:-bathroom living-room})
 rounds=${SC_ROUNDS:-5}
 spp=${SC_SPP:-16}
 threads=${SC_THREADS:-2}
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-
-for t in "$old" "$new"; do [ -x "$t" ] || { echo "sample_cost.sh: no tessera binary at $t" >&2; exit 1; }; done
-for s in "${scenes[@]}"; do
-  [ -f "$shared/scenes/$s/scene.xml" ] || { echo "sample_cost.sh: missing $shared/scenes/$s/scene.xml" >&2; exit 1; }
-done
+compare_builds_setup sample_cost.sh "$@"
 
 # Prints the render seconds of one run.
 run() {
@@ -32,7 +23,6 @@ run() {
     -o "$tmp/out.exr" > "$tmp/log" 2>&1 || { cat "$tmp/log" >&2; exit 1; }
   sed -n 's/^times: .*, render \([0-9.]*\) s.*/\1/p' "$tmp/log"
 }
-median() { sort -g | awk '{ v[NR] = $1 } END { print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
 
 echo "$spp spp, 320x180, $threads threads, $rounds rounds"
 printf '| scene | OLD render (s) | NEW render (s) | OLD / NEW (median of rounds) |\n|---|---|---|---|\n'

@@ -11,19 +11,10 @@
 # A missing scene is an error, never a skip. The file cache is warmed by one untimed run each.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-[ $# -eq 2 ] || { echo "usage: bench/scene_load.sh OLD_BUILD_DIR NEW_BUILD_DIR" >&2; exit 2; }
-old=$1/cli/tessera
-new=$2/cli/tessera
-shared=../shared
+. bench/compare_builds.sh
 scenes=(${SL_SCENES:-bathroom kitchenette living-room staircase2})
 rounds=${SL_ROUNDS:-5}
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-
-for t in "$old" "$new"; do [ -x "$t" ] || { echo "scene_load.sh: no tessera binary at $t" >&2; exit 1; }; done
-for s in "${scenes[@]}"; do
-  [ -f "$shared/scenes/$s/scene.xml" ] || { echo "scene_load.sh: missing $shared/scenes/$s/scene.xml" >&2; exit 1; }
-done
+compare_builds_setup scene_load.sh "$@"
 
 # Prints "load bvh" (seconds) of one run, and keeps its log for the memory line.
 run() {
@@ -31,7 +22,6 @@ run() {
     { cat "$tmp/log" >&2; exit 1; }
   sed -n 's/^times: parse [0-9.]* s, load \([0-9.]*\) s (BVH build \([0-9.]*\) s).*/\1 \2/p' "$tmp/log"
 }
-median() { sort -g | awk '{ v[NR] = $1 } END { print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
 
 printf '| scene | load OLD (s) | load NEW (s) | speed-up | load+BVH OLD (s) | load+BVH NEW (s) | speed-up | textures NEW (MB) | textures as float (MB) |\n'
 printf '|---|---|---|---|---|---|---|---|---|\n'
