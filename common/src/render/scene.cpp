@@ -146,34 +146,27 @@ void Scene::flag_see_through() {
   see_through_ = std::move(bits);
 }
 
-namespace {
-
 /// What a shadow ray crossed so far in one any-hit query through cut-outs (HitFilter's ctx).
-struct MaskCrossings {
+struct Scene::MaskCrossings {
   const Scene* scene;
-  float (*opacity_at)(const Scene&, const Ray&, const Hit&);
   float tr = 1.f;
   int crossings = 0;
   static bool occludes(void* ctx, const Ray& ray, const Hit& hit) {
     auto& c = *static_cast<MaskCrossings*>(ctx);
     if (++c.crossings > kMaxMaskCrossings) return true;
-    c.tr *= 1.f - c.opacity_at(*c.scene, ray, hit);
+    SurfaceInteraction si;
+    c.scene->fill(ray, hit, si);
+    c.tr *= 1.f - masked_opacity(si);
     return !(c.tr > 0.f);
   }
 };
-
-}  // namespace
 
 float Scene::transmittance(const Ray& ray) const {
   if (!has_masks_) return occluded(ray) ? 0.f : 1.f;
   if (!see_through_.empty()) {
     // Every primitive on the segment is offered once, so the product over the cut-outs is the
     // one the loop below finds, without a closest-hit query (and a fill) per surface.
-    MaskCrossings c{this, [](const Scene& scene, const Ray& r, const Hit& hit) {
-                      SurfaceInteraction si;
-                      scene.fill(r, hit, si);
-                      return masked_opacity(si);
-                    }};
+    MaskCrossings c{this};
     if (accel_.occluded(ray, HitFilter{see_through_.data(), &MaskCrossings::occludes, &c})) return 0.f;
     if (!top_.empty() && top_.occluded(ray)) return 0.f;
     return c.tr;

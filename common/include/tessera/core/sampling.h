@@ -1,12 +1,9 @@
-// Warping functions from [0,1)^n to common distributions, and tabulated distributions. Every pdf
-// here is stated with its measure.
+// Warping functions from [0,1)^n to common distributions (tabulated ones: core/distribution.h).
+// Every pdf here is stated with its measure.
 #pragma once
 
 #include "tessera/core/ray.h"
 #include "tessera/core/vec.h"
-
-#include <cstdint>
-#include <vector>
 
 namespace tessera {
 

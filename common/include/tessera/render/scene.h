@@ -179,6 +179,7 @@ class Scene {
   }
   void build_instances();
   void flag_see_through();
+  struct MaskCrossings;  // scene.cpp: a shadow ray's product over cut-outs, as a HitFilter context
   void fill_placed(const Ray& ray, const Hit& hit, SurfaceInteraction& si) const;
 };
 
