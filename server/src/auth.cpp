@@ -13,6 +13,8 @@ Access required_access(const std::string& method, const std::string& path) {
   if (path == "/healthz") return Access::Open;
   // The dashboard's static files hold no data: the page asks for the client token itself.
   if ((method == "GET" || method == "HEAD") && (path == "/" || path.rfind("/ui/", 0) == 0)) return Access::Open;
+  // Nor does the API description.
+  if ((method == "GET" || method == "HEAD") && path == "/api/v1/openapi.json") return Access::Open;
   // Draining a worker is an operator's action.
   const std::string drain = "/drain";
   if (path.rfind("/api/v1/workers/", 0) == 0 && path.size() > drain.size() &&

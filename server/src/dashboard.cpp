@@ -8,16 +8,17 @@ namespace tessera::server {
 
 namespace {
 
-struct Route {
+struct StaticRoute {
   const char* path;  // an httplib route: a regex
   const char* asset;
   const char* content_type;
 };
 
-constexpr Route kRoutes[] = {
+constexpr StaticRoute kRoutes[] = {
     {"/", "index.html", "text/html; charset=utf-8"},
     {R"(/ui/app\.js)", "app.js", "text/javascript; charset=utf-8"},
     {R"(/ui/style\.css)", "style.css", "text/css; charset=utf-8"},
+    {R"(/api/v1/openapi\.json)", "openapi.json", "application/json"},
 };
 
 }  // namespace
@@ -28,10 +29,12 @@ const WebAsset* find_web_asset(std::string_view name) {
   return nullptr;
 }
 
-void install_dashboard(httplib::Server& http) {
-  for (const Route& route : kRoutes) {
+std::vector<Route> install_dashboard(httplib::Server& http) {
+  std::vector<Route> routes;
+  for (const StaticRoute& route : kRoutes) {
     const WebAsset* asset = find_web_asset(route.asset);
     if (!asset) continue;  // not embedded (server/CMakeLists.txt lists the files): a 404
+    routes.push_back({"GET", route.path});
     const std::string content_type = route.content_type;
     http.Get(route.path, [asset, content_type](const httplib::Request&, httplib::Response& res) {
       res.set_header("Cache-Control", "no-cache");
@@ -39,6 +42,7 @@ void install_dashboard(httplib::Server& http) {
       res.set_content(reinterpret_cast<const char*>(asset->data), asset->size, content_type);
     });
   }
+  return routes;
 }
 
 }  // namespace tessera::server

@@ -4,6 +4,7 @@
 #include "event_log.h"
 
 #include "dashboard.h"
+#include "response_recorder.h"
 
 #include <httplib.h>
 #include <spdlog/spdlog.h>
@@ -157,14 +158,32 @@ std::string bundle_of(const httplib::Request& req) {
   return req.body;
 }
 
+// Registers routes with httplib and keeps their list.
+class Router {
+ public:
+  explicit Router(httplib::Server& http) : http_(http) {}
+  void get(const char* pattern, httplib::Server::Handler h) { add("GET", pattern), http_.Get(pattern, std::move(h)); }
+  void post(const char* pattern, httplib::Server::Handler h) { add("POST", pattern), http_.Post(pattern, std::move(h)); }
+  void patch(const char* pattern, httplib::Server::Handler h) { add("PATCH", pattern), http_.Patch(pattern, std::move(h)); }
+  void del(const char* pattern, httplib::Server::Handler h) { add("DELETE", pattern), http_.Delete(pattern, std::move(h)); }
+  void add(const std::vector<Route>& more) { routes_.insert(routes_.end(), more.begin(), more.end()); }
+  std::vector<Route> take() { return std::move(routes_); }
+
+ private:
+  void add(const char* method, const char* pattern) { routes_.push_back({method, pattern}); }
+  httplib::Server& http_;
+  std::vector<Route> routes_;
+};
+
 }  // namespace
 
-void install_routes(httplib::Server& http, Coordinator& c, uint64_t max_upload_bytes, const AuthTokens& tokens,
-                    ConnectionGuard* guard) {
+std::vector<Route> install_routes(httplib::Server& http, Coordinator& c, uint64_t max_upload_bytes,
+                                  const AuthTokens& tokens, ConnectionGuard* guard, ResponseRecorder* recorder) {
   http.set_payload_max_length(size_t(max_body_bytes(max_upload_bytes)));
   auto peer = [](const httplib::Request& req) { return req.remote_addr + ":" + std::to_string(req.remote_port); };
-  http.set_logger([guard, peer](const httplib::Request& req, const httplib::Response& res) {
+  http.set_logger([guard, recorder, peer](const httplib::Request& req, const httplib::Response& res) {
     if (guard) guard->request_finished(peer(req));
+    if (recorder) recorder->record(req, res);
     log_event(spdlog::level::debug, "http.request",
               {{"method", req.method}, {"path", req.path}, {"status", res.status}, {"peer", peer(req)}});
   });
@@ -182,32 +201,33 @@ void install_routes(httplib::Server& http, Coordinator& c, uint64_t max_upload_b
     return httplib::Server::HandlerResponse::Unhandled;
   });
 
-  http.Get("/healthz", [&c](const httplib::Request&, httplib::Response& res) { send_json(res, 200, to_json(c.health())); });
-  install_dashboard(http);
+  Router r(http);
+  r.get("/healthz", [&c](const httplib::Request&, httplib::Response& res) { send_json(res, 200, to_json(c.health())); });
+  r.add(install_dashboard(http));
 
-  http.Get("/metrics", [&c](const httplib::Request&, httplib::Response& res) {
+  r.get("/metrics", [&c](const httplib::Request&, httplib::Response& res) {
     res.set_content(c.metrics(), "text/plain; version=0.0.4");
   });
 
-  http.Post("/api/v1/scenes", [&c](const httplib::Request& req, httplib::Response& res) {
+  r.post("/api/v1/scenes", [&c](const httplib::Request& req, httplib::Response& res) {
     std::string bundle = bundle_of(req);
     if (bundle.empty())
       return send_error(res, make_error(Code::BadRequest, "no_bundle", "send the bundle as the body or field 'bundle'"));
     send(res, c.upload_scene(bundle), 201);
   });
-  http.Get(R"(/api/v1/scenes/([0-9a-f]{64}))", [&c](const httplib::Request& req, httplib::Response& res) {
+  r.get(R"(/api/v1/scenes/([0-9a-f]{64}))", [&c](const httplib::Request& req, httplib::Response& res) {
     Result<std::string> bundle = c.scene_bundle(req.matches[1].str());
     if (!bundle.ok()) return send_error(res, bundle.status);
     res.set_content(bundle.value, "application/octet-stream");
   });
 
-  http.Get(R"(/api/v1/guides/([0-9a-f]{64}))", [&c](const httplib::Request& req, httplib::Response& res) {
+  r.get(R"(/api/v1/guides/([0-9a-f]{64}))", [&c](const httplib::Request& req, httplib::Response& res) {
     Result<std::string> guide = c.guide(req.matches[1].str());
     if (!guide.ok()) return send_error(res, guide.status);
     res.set_content(guide.value, "application/octet-stream");
   });
 
-  http.Post("/api/v1/jobs", [&c](const httplib::Request& req, httplib::Response& res) {
+  r.post("/api/v1/jobs", [&c](const httplib::Request& req, httplib::Response& res) {
     json settings;
     std::string bundle;
     if (req.is_multipart_form_data()) {
@@ -225,12 +245,12 @@ void install_routes(httplib::Server& http, Coordinator& c, uint64_t max_upload_b
       return send_error(res, make_error(Code::BadRequest, "bad_settings", error));
     send(res, c.submit_job(request, bundle), 201);
   });
-  http.Get("/api/v1/jobs", [&c](const httplib::Request&, httplib::Response& res) { send_list(res, "jobs", c.list_jobs()); });
-  http.Get(R"(/api/v1/jobs/(\d+))", [&c](const httplib::Request& req, httplib::Response& res) {
+  r.get("/api/v1/jobs", [&c](const httplib::Request&, httplib::Response& res) { send_list(res, "jobs", c.list_jobs()); });
+  r.get(R"(/api/v1/jobs/(\d+))", [&c](const httplib::Request& req, httplib::Response& res) {
     uint64_t id;
     if (parse_id(req, 1, id, res)) send(res, c.job_status(id));
   });
-  http.Get(R"(/api/v1/jobs/(\d+)/image)", [&c](const httplib::Request& req, httplib::Response& res) {
+  r.get(R"(/api/v1/jobs/(\d+)/image)", [&c](const httplib::Request& req, httplib::Response& res) {
     uint64_t id;
     if (!parse_id(req, 1, id, res)) return;
     const bool denoised = req.has_param("denoised") && req.get_param_value("denoised") != "0";
@@ -239,12 +259,12 @@ void install_routes(httplib::Server& http, Coordinator& c, uint64_t max_upload_b
     if (!image.ok()) return send_error(res, image.status);
     res.set_content(image.value.bytes, image.value.content_type.c_str());
   });
-  http.Delete(R"(/api/v1/jobs/(\d+))", [&c](const httplib::Request& req, httplib::Response& res) {
+  r.del(R"(/api/v1/jobs/(\d+))", [&c](const httplib::Request& req, httplib::Response& res) {
     uint64_t id;
     if (parse_id(req, 1, id, res)) send(res, c.cancel_job(id));
   });
 
-  http.Patch(R"(/api/v1/jobs/(\d+))", [&c](const httplib::Request& req, httplib::Response& res) {
+  r.patch(R"(/api/v1/jobs/(\d+))", [&c](const httplib::Request& req, httplib::Response& res) {
     uint64_t id;
     json body;
     if (!parse_id(req, 1, id, res) || !parse_body(req, res, body)) return;
@@ -252,16 +272,16 @@ void install_routes(httplib::Server& http, Coordinator& c, uint64_t max_upload_b
       return send_error(res, make_error(Code::BadRequest, "bad_request", "send {\"priority\": N}"));
     send(res, c.set_priority(id, body["priority"].get<int>()));
   });
-  http.Post(R"(/api/v1/jobs/(\d+)/retry)", [&c](const httplib::Request& req, httplib::Response& res) {
+  r.post(R"(/api/v1/jobs/(\d+)/retry)", [&c](const httplib::Request& req, httplib::Response& res) {
     uint64_t id;
     if (parse_id(req, 1, id, res)) send(res, c.retry_job(id));
   });
 
-  http.Post(R"(/api/v1/workers/(\d+)/drain)", [&c](const httplib::Request& req, httplib::Response& res) {
+  r.post(R"(/api/v1/workers/(\d+)/drain)", [&c](const httplib::Request& req, httplib::Response& res) {
     uint64_t id;
     if (parse_id(req, 1, id, res)) send(res, c.drain_worker(id));
   });
-  http.Post("/api/v1/workers", [&c](const httplib::Request& req, httplib::Response& res) {
+  r.post("/api/v1/workers", [&c](const httplib::Request& req, httplib::Response& res) {
     json body;
     if (!parse_body(req, res, body)) return;
     WorkerHello hello;
@@ -270,10 +290,10 @@ void install_routes(httplib::Server& http, Coordinator& c, uint64_t max_upload_b
       return send_error(res, make_error(Code::BadRequest, "bad_registration", error));
     send(res, c.register_worker(hello), 201);
   });
-  http.Get("/api/v1/workers", [&c](const httplib::Request&, httplib::Response& res) {
+  r.get("/api/v1/workers", [&c](const httplib::Request&, httplib::Response& res) {
     send_list(res, "workers", c.list_workers());
   });
-  http.Post(R"(/api/v1/workers/(\d+)/lease)", [&c](const httplib::Request& req, httplib::Response& res) {
+  r.post(R"(/api/v1/workers/(\d+)/lease)", [&c](const httplib::Request& req, httplib::Response& res) {
     uint64_t id;
     if (!parse_id(req, 1, id, res)) return;
     Result<std::optional<Lease>> lease = c.lease(id, query_number(req, "wait", 0));
@@ -285,7 +305,7 @@ void install_routes(httplib::Server& http, Coordinator& c, uint64_t max_upload_b
     }
     send_json(res, 200, to_json(*lease.value), /*compact=*/true);
   });
-  http.Post(R"(/api/v1/workers/(\d+)/heartbeat)", [&c](const httplib::Request& req, httplib::Response& res) {
+  r.post(R"(/api/v1/workers/(\d+)/heartbeat)", [&c](const httplib::Request& req, httplib::Response& res) {
     uint64_t id;
     json body;
     if (!parse_id(req, 1, id, res) || !parse_body(req, res, body)) return;
@@ -297,21 +317,21 @@ void install_routes(httplib::Server& http, Coordinator& c, uint64_t max_upload_b
     if (!drop.ok()) return send_error(res, drop.status);
     send_json(res, 200, json{{"drop", drop.value}});
   });
-  http.Post(R"(/api/v1/workers/(\d+)/results)", [&c](const httplib::Request& req, httplib::Response& res) {
+  r.post(R"(/api/v1/workers/(\d+)/results)", [&c](const httplib::Request& req, httplib::Response& res) {
     uint64_t id;
     if (!parse_id(req, 1, id, res)) return;
     // (Compact, as the lease's answer: a worker's hot path, read by programs.)
     send(res, c.upload_result(id, uint64_t(query_number(req, "lease", 0)), req.body, query_number(req, "next", 0) != 0),
          200, /*compact=*/true);
   });
-  http.Post(R"(/api/v1/workers/(\d+)/leases/(\d+)/fail)", [&c](const httplib::Request& req, httplib::Response& res) {
+  r.post(R"(/api/v1/workers/(\d+)/leases/(\d+)/fail)", [&c](const httplib::Request& req, httplib::Response& res) {
     uint64_t id, lease;
     json body;
     if (!parse_id(req, 1, id, res) || !parse_id(req, 2, lease, res) || !parse_body(req, res, body)) return;
     const bool has_reason = body.is_object() && body.contains("error") && body["error"].is_string();
     send(res, c.fail_lease(id, lease, has_reason ? body["error"].get<std::string>() : "unspecified"));
   });
-  http.Delete(R"(/api/v1/workers/(\d+))", [&c](const httplib::Request& req, httplib::Response& res) {
+  r.del(R"(/api/v1/workers/(\d+))", [&c](const httplib::Request& req, httplib::Response& res) {
     uint64_t id;
     json body;
     if (parse_id(req, 1, id, res) && parse_body(req, res, body)) send(res, c.sign_off(id));
@@ -335,6 +355,7 @@ void install_routes(httplib::Server& http, Coordinator& c, uint64_t max_upload_b
     log_event(spdlog::level::err, "http.exception", {{"method", req.method}, {"path", req.path}, {"error", what}});
     send_json(res, 500, json{{"error", "internal"}, {"detail", what}});
   });
+  return r.take();
 }
 
 }  // namespace tessera::server

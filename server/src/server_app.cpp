@@ -1,6 +1,7 @@
 #include "tessera/server/server_app.h"
 
 #include "connection_guard.h"
+#include "response_recorder.h"
 #include "event_log.h"
 #include "scene_planner.h"
 #include "tessera/farm/protocol.h"
@@ -226,8 +227,16 @@ int run_server(const ServerOptions& o) {
     std::fprintf(stderr, "tessera-server: cannot listen on %s\n", o.listen.c_str());
     return 1;
   }
+  std::unique_ptr<ResponseRecorder> recorder;
+  if (!o.record_responses.empty()) {
+    std::string error;
+    if (!(recorder = ResponseRecorder::open(o.record_responses, error))) {
+      std::fprintf(stderr, "tessera-server: --record-responses: %s\n", error.c_str());
+      return 2;
+    }
+  }
   ConnectionGuard guard(bound, o.header_timeout);
-  install_routes(*http, *coordinator, o.coordinator.max_upload_bytes, tokens, &guard);
+  (void)install_routes(*http, *coordinator, o.coordinator.max_upload_bytes, tokens, &guard, recorder.get());
   if (!o.port_file.empty()) std::ofstream(o.port_file) << bound << "\n";
   const bool tls = !o.tls_cert.empty();
   const std::string local_host = host == "0.0.0.0" || host == "::" ? std::string("127.0.0.1") : host;

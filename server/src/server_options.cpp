@@ -80,6 +80,10 @@ int parse_server_args(int argc, char** argv, ServerOptions& o) {
   auto* logging = "Logging";
   app.add_option("--log-format", o.log_format, "text, or json: one JSON object per line")
       ->check(CLI::IsMember({"text", "json"}))->capture_default_str()->group(logging);
+  app.add_option("--record-responses", o.record_responses,
+                 "append every answer (method, path, status, JSON body) to this file, a JSON object a line: for "
+                 "checking the API description (docs/openapi.json) against real traffic")
+      ->group(logging);
   app.add_option("--log-level", o.log_level, "debug (every lease), info (every job), warn or error")
       ->check(CLI::IsMember({"debug", "info", "warn", "error"}))->capture_default_str()->group(logging);
   try {

@@ -58,12 +58,14 @@ TEST(FarmAuth, EveryCallNeedsTheRightToken) {
   std::printf("refused %d unauthorised calls\n", refused);
   EXPECT_TRUE(none.get("/healthz").ok()) << "health checks need no token";
   // The dashboard's page and files are open (they hold no data); what the page asks for is not.
-  for (const char* path : {"/", "/ui/app.js", "/ui/style.css"}) {
+  // So is the API description (docs/openapi.json).
+  for (const char* path : {"/", "/ui/app.js", "/ui/style.css", "/api/v1/openapi.json"}) {
     client::HttpReply page = none.get(path, 5);
     EXPECT_EQ(page.status, 200) << path;
     EXPECT_FALSE(page.body.empty()) << path;
   }
   EXPECT_NE(none.get("/", 5).body.find("<title>Tessera farm</title>"), std::string::npos);
+  EXPECT_EQ(none.get("/api/v1/openapi.json", 5).json().value("openapi", ""), "3.1.0");
   EXPECT_EQ(none.get("/api/v1/jobs", 5).status, 401) << "the dashboard opens the page, not the API";
   EXPECT_EQ(none.post_bytes("/", "x", "text/plain", 5).status, 401) << "only GET is open";
 }

@@ -13,7 +13,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <string>
@@ -112,6 +114,13 @@ class Farm {
     std::vector<std::string> args = {TESSERA_SERVER_BIN, "--listen", "127.0.0.1:" + std::to_string(port_),
                                      "--port-file", port_file, "--data-dir", (dir_.path / "data").string()};
     args.insert(args.end(), flags_.begin(), flags_.end());
+    // With TESSERA_RECORD_RESPONSES=DIR, every answer goes to a file of its own in DIR, for
+    // tests/docs/openapi_responses_test.py (tests/CMakeLists.txt sets it).
+    if (const char* dir = std::getenv("TESSERA_RECORD_RESPONSES"); dir && *dir) {
+      static std::atomic<int> servers{0};
+      args.insert(args.end(), {"--record-responses", std::string(dir) + "/responses-" + std::to_string(::getpid()) +
+                                                         "-" + std::to_string(servers++) + ".jsonl"});
+    }
     server_ = Child(args, log("server"));
     for (int i = 0; i < 500 && port_ == 0; ++i) {
       std::ifstream in(port_file);

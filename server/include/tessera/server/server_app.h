@@ -20,6 +20,7 @@ struct ServerOptions {
   double header_timeout = 10;             // seconds a connection may take to send a request's headers
   std::string log_format = "text";        // text or json (one JSON object per line)
   std::string log_level = "info";         // debug shows every lease; info every job state change
+  std::string record_responses;           // file: every answer, a JSON line each (response_recorder.h)
   CoordinatorOptions coordinator;
 };
 
