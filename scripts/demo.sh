@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Sets up Tessera and renders the demo scene through the render farm: a coordinator with local
-# workers on this machine, `tessera submit --wait`, the image downloaded to OUT (+ .exr).
+# Sets up Tessera and renders the demo scene (scenes/demo) through the render farm: a coordinator
+# with local workers on this machine, `tessera submit --wait --denoise`; the denoised image is
+# downloaded to OUT (+ .exr) and the raw one beside it as OUT_STEM.noisy.png (+ .noisy.exr).
 # Usage: scripts/demo.sh [OUT.png] [LOCAL_WORKERS]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -23,5 +24,7 @@ for _ in $(seq 100); do [ -s "$data/port" ] && break; sleep 0.1; done
 url="http://127.0.0.1:$(cat "$data/port")"
 echo "demo: coordinator at $url with $workers local workers"
 
-./build/cli/tessera submit scenes/demo/scene.xml --server "$url" --wait -o "$out" -o "${out%.*}.exr"
-echo "demo: wrote $out and ${out%.*}.exr (rendered by the farm)"
+start=$(date +%s)
+./build/cli/tessera submit scenes/demo/scene.xml --server "$url" --wait --denoise -o "$out" -o "${out%.*}.exr"
+echo "demo: the farm rendered and denoised it in $(( $(date +%s) - start )) s: wrote $out and ${out%.*}.exr" \
+     "(denoised), ${out%.*}.noisy.png and ${out%.*}.noisy.exr (raw)"

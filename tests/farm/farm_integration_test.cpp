@@ -4,6 +4,7 @@
 #include "farm_harness.h"
 #include "tessera/denoise/denoiser.h"
 
+#include <cmath>
 #include <iterator>
 
 namespace tessera::test {
@@ -359,6 +360,36 @@ TEST(FarmIntegration, DenoisedJobIsTheLocalRenderAndItsDenoisedImage) {
   EXPECT_EQ(raw.half_b.values(), expected.half_b.values());
   EXPECT_EQ(read_exr(out).values(), read_exr(again).values());
   EXPECT_EQ(read_exr(out).values(), denoise(expected).values());
+}
+
+// The demo (scenes/demo, what scripts/demo.sh renders), smaller: through the farm with the
+// denoiser it is `tessera render`'s image bit for bit, finite everywhere, raw and denoised, and it
+// loads with nothing unsupported and no warning.
+TEST(FarmIntegration, DemoSceneRendersThroughTheFarmAsLocally) {
+  const std::string scene = std::string(TESSERA_SOURCE_DIR) + "/scenes/demo/scene.xml";
+  Farm farm;
+  farm.start_server();
+  farm.add_worker(1);
+  farm.add_worker(1);
+  ASSERT_TRUE(farm.wait_workers(2));
+  const std::string out = (farm.dir().path / "demo.exr").string(), noisy = (farm.dir().path / "demo.noisy.exr").string();
+  const std::string local = (farm.dir().path / "local.exr").string();
+  const std::string cli = std::string(TESSERA_CLI_BIN) + " ", flags = " --spp 6 --width 160 --height 100";
+  const std::string submit_log = farm.log("demo-submit"), render_log = farm.log("demo-render");
+  ASSERT_EQ(std::system((cli + "submit " + scene + " --server " + farm.url() + flags + " -q --denoise -o " + out +
+                         " > " + submit_log + " 2>&1").c_str()),
+            0);
+  ASSERT_EQ(std::system((cli + "render " + scene + flags + " -o " + local + " > " + render_log + " 2>&1").c_str()), 0);
+  const Image raw = read_exr(noisy), denoised = read_exr(out);
+  EXPECT_EQ(differing_pixels(raw, read_exr(local)), 0);
+  for (const Image* image : {&raw, &denoised})
+    for (float v : image->values()) ASSERT_TRUE(std::isfinite(v));
+  std::ifstream in(render_log);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (char& ch : text) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+  EXPECT_EQ(text.find("unsupported"), std::string::npos) << text;
+  EXPECT_EQ(text.find("warning"), std::string::npos) << text;
+  EXPECT_NE(text.find("render: 160x100, 6 spp"), std::string::npos) << text;
 }
 
 }  // namespace
