@@ -26,7 +26,7 @@ Access required_access(const std::string& method, const std::string& path) {
   }
   // Workers download bundles; clients may fetch what they uploaded.
   if (method == "GET" && path.rfind("/api/v1/scenes/", 0) == 0) return Access::ClientOrWorker;
-  // Guided jobs' learned guides (guide_artifact.h), for workers and anyone curious.
+  // Guided jobs' learned guides (guide_artifact.h), for workers and for clients who want to look.
   if (method == "GET" && path.rfind("/api/v1/guides/", 0) == 0) return Access::ClientOrWorker;
   if (path.rfind("/api/", 0) == 0) return Access::Client;
   return Access::Client;  // anything else (unknown paths included) is not for strangers

@@ -12,7 +12,7 @@ namespace tessera {
 
 struct WorkerStatus {
   uint64_t id = 0;
-  std::string name, state;  // state: active, draining, lost, gone
+  std::string name, state;  // state: idle, busy, draining, lost, gone
   int threads = 0;
   uint64_t units_done = 0, samples_done = 0;
   double samples_per_second = 0;  // over its render time

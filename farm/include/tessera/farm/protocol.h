@@ -34,8 +34,7 @@ struct JobSettings {
   /// Adaptive sampling (render/adaptive.h): later passes spend the budget where the film's variance
   /// is. The farm decides each such pass's counts at its barrier, from the film, as render() does.
   bool adaptive = false;
-  /// Path guiding: empty lets the scene decide (its guided_path integrator asks for it). The farm
-  /// does not guide yet, so a job that would be guided is refused rather than rendered otherwise.
+  /// Path guiding: empty lets the scene decide (its guided_path integrator asks for it).
   std::optional<bool> guiding;
   /// Denoise the finished image (denoise/denoiser.h): units render the AOV sums too, and the job is
   /// done once the raw image (with its AOV layers) and the denoised one are stored.

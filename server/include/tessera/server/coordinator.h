@@ -45,7 +45,7 @@ struct CoordinatorOptions {
   JobLimits limits;
   BundleLimits bundle_limits;
   uint64_t max_upload_bytes = uint64_t(4) << 30;
-  int max_active_jobs = 10000;
+  int max_active_jobs = 10000;  // queued + running; more are refused with 429 until some end
   // Retention (retention.h): finished jobs older than this many days since they ended are deleted
   // with their results and image; 0 keeps them forever.
   double retain_days = 0;
@@ -59,7 +59,7 @@ struct CoordinatorOptions {
   // tessera-server itself), so the memory of loading it goes back to the system; empty: in this
   // process (tests).
   std::string scene_planner;
-  std::vector<std::string> webhook_allow;  // URL prefixes a job's webhook must start with; empty: any  // queued + running; more are refused with 429 until some end
+  std::vector<std::string> webhook_allow;  // URL prefixes a job's webhook must start with; empty: any
 };
 
 /// What a retention pass did: jobs and bundles deleted, bytes freed, bytes the data dir still holds.
