@@ -187,6 +187,13 @@ def check_dockerfile(c, root, flags):
                   if ignored(rules, os.path.relpath(os.path.join(dirpath, f), root))]
         c.check(not hidden, "Dockerfile: .dockerignore leaves out no file of the folders the build adds",
                 f"ignored: {hidden[:5]}")
+    # Files outside those folders that their CMakeLists read (e.g. the API description the server
+    # compiles in) must reach the build too.
+    for d in needed:
+        lists = os.path.join(root, d, "CMakeLists.txt") if os.path.isdir(os.path.join(root, d)) else None
+        for ref in re.findall(r"\$\{PROJECT_SOURCE_DIR\}/([\w./-]+)", open(lists).read() if lists else ""):
+            c.check(os.path.exists(os.path.join(root, ref)) and not ignored(rules, ref),
+                    f"Dockerfile: {ref}, read by {d}/CMakeLists.txt, is in the build context")
     if "tests" not in copied:
         c.check("-DTESSERA_BUILD_TESTS=OFF" in build_runs, "Dockerfile: tests/ not copied, so TESSERA_BUILD_TESTS=OFF")
 
