@@ -342,10 +342,7 @@ TEST(FarmIntegration, SubmitCommandDownloadsTheSameImage) {
 TEST(FarmIntegration, DenoisedJobIsTheLocalRenderAndItsDenoisedImage) {
   TESSERA_REQUIRE_FILE(cornell());
   Farm farm;
-  farm.start_server();
-  farm.add_worker(1);
-  farm.add_worker(1);
-  ASSERT_TRUE(farm.wait_workers(2));
+  ASSERT_TRUE(start_with_two_workers(farm));
   const std::string out = (farm.dir().path / "dn.exr").string(), noisy = (farm.dir().path / "dn.noisy.exr").string();
   const std::string local = (farm.dir().path / "local.exr").string(), again = (farm.dir().path / "again.exr").string();
   const std::string cli = std::string(TESSERA_CLI_BIN) + " ";
@@ -368,10 +365,7 @@ TEST(FarmIntegration, DenoisedJobIsTheLocalRenderAndItsDenoisedImage) {
 TEST(FarmIntegration, DemoSceneRendersThroughTheFarmAsLocally) {
   const std::string scene = std::string(TESSERA_SOURCE_DIR) + "/scenes/demo/scene.xml";
   Farm farm;
-  farm.start_server();
-  farm.add_worker(1);
-  farm.add_worker(1);
-  ASSERT_TRUE(farm.wait_workers(2));
+  ASSERT_TRUE(start_with_two_workers(farm));
   const std::string out = (farm.dir().path / "demo.exr").string(), noisy = (farm.dir().path / "demo.noisy.exr").string();
   const std::string local = (farm.dir().path / "local.exr").string();
   const std::string cli = std::string(TESSERA_CLI_BIN) + " ", flags = " --spp 6 --width 160 --height 100";
