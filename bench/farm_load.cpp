@@ -9,7 +9,7 @@
 
 #include "tessera/farm/bundle.h"
 #include "tessera/farm/build_fingerprint.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 #include "tessera/client/farm_api.h"
 
 #include <CLI/CLI.hpp>

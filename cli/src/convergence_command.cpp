@@ -4,7 +4,7 @@
 #include "tessera/image/image.h"
 #include "tessera/render/integrator.h"
 #include "tessera/render/noise_estimate.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 #include "tessera/scene/load_context.h"
 #include "tessera/scene/scene_desc.h"
 
@@ -102,7 +102,6 @@ int run_bench_convergence(const ConvergenceOptions& options) {
     for (const Series& one : series) {
       scene.integrator.strategy = one.strategy;
       settings.guiding = one.guiding;
-      if (scene.integrator.guiding) settings.guiding_settings = *scene.integrator.guiding;
       settings.adaptive = one.adaptive;
       std::vector<ConvergencePoint> mine;
       auto run_budget = [&](size_t index, int spp) {

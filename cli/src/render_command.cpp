@@ -3,7 +3,8 @@
 #include "tessera/cli/progress.h"
 #include "tessera/denoise/denoiser.h"
 #include "tessera/image/image.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/path_program.h"
+#include "tessera/sequence/renderer.h"
 #include "tessera/render/shape.h"
 #include "tessera/scene/load_context.h"
 #include "tessera/scene/scene_desc.h"
@@ -160,9 +161,8 @@ int run_render(const RenderOptions& options) {
     settings.threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
     settings.tile_size = options.tile_size;
     settings.target_error = options.target_error;
-    // Guiding as the command line says, else as the scene's integrator does (guided_path).
-    settings.guiding = options.guiding.empty() ? scene.integrator.guiding.has_value() : options.guiding == "on";
-    if (scene.integrator.guiding) settings.guiding_settings = *scene.integrator.guiding;
+    // Guiding as the command line says, else as the scene's integrator does (guide_plan()).
+    if (!options.guiding.empty()) settings.guiding = options.guiding == "on";
     settings.adaptive = options.adaptive == "on";
     settings.aovs = !aovs.empty() || options.denoise;
 
@@ -206,7 +206,7 @@ int run_render(const RenderOptions& options) {
     std::fprintf(stderr, "\n");
     if (stats.guide_leaves > 0)
       std::fprintf(stderr, "guide: %zu spatial leaves, %.1f MB (cap %.0f MB)\n", stats.guide_leaves,
-                   double(stats.guide_bytes) / 1e6, double(settings.guiding_settings.max_bytes) / 1e6);
+                   double(stats.guide_bytes) / 1e6, double(guide_plan(scene, settings.guiding)->settings.max_bytes) / 1e6);
     if (settings.target_error > 0)
       std::fprintf(stderr, "target error %g: %s at %u spp, estimated relMSE %.4g\n", settings.target_error,
                    stats.spp_done < uint32_t(settings.spp) ? "stopped" : "not reached, budget spent", stats.spp_done,

@@ -1,7 +1,7 @@
 #include "tessera/farm/build_fingerprint.h"
 
 #include "tessera/farm/sha256.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 #include "tessera/scene/load_context.h"
 #include "tessera/scene/scene_desc.h"
 

@@ -3,7 +3,7 @@
 #include "tessera/farm/bundle.h"
 #include "tessera/guiding/tree_io.h"
 #include "tessera/render/light_sampler.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 #include "tessera/scene/error.h"
 
 #include <algorithm>
@@ -41,11 +41,7 @@ JobPlan make_job_plan(const std::string& bundle_dir, const std::string& scene_fi
                       const LoadedJobScene& scene) {
   const Scene& s = *scene.loaded.scene;
   JobPlan plan;
-  // Guided as `tessera render` guides: as the job says, else as the scene's integrator does, on
-  // path and volpath with something to guide over.
-  if (settings.guiding.value_or(s.integrator.guiding.has_value()) && s.integrator.type != IntegratorType::Direct &&
-      !s.bounds().empty())
-    plan.guide = JobPlan::Guide{s.bounds(), s.integrator.guiding.value_or(GuidingSettings{})};
+  plan.guide = guide_plan(s, settings.guiding);  // (as `tessera render` guides)
   plan.settings = settings;
   plan.settings.spp = s.sampler.sample_count;
   plan.settings.width = s.film.width;
@@ -65,6 +61,10 @@ JobPlan make_job_plan(const std::string& bundle_dir, const std::string& scene_fi
     if (std::find(plan.files.begin(), plan.files.end(), rel) == plan.files.end()) plan.files.push_back(rel);
   }
   return plan;
+}
+
+PathProgramOptions path_options(const JobPlan& plan) {
+  return {uint32_t(plan.settings.spp), plan.settings.target_error, plan.settings.adaptive, AdaptiveSettings{}, plan.guide};
 }
 
 void begin_tile_result(const Lease& lease, TileResult& out) {

@@ -4,7 +4,7 @@
 #include "event_log.h"
 
 #include "tessera/denoise/denoiser.h"
-#include "tessera/farm/guide_artifact.h"
+#include "tessera/sequence/guide_artifact.h"
 #include "tessera/farm/sample_counts.h"
 #include "tessera/farm/sha256.h"
 #include "tessera/farm/tile_result.h"
@@ -178,7 +178,7 @@ std::unique_ptr<JobState> Coordinator::Impl::rebuild_job(const JobRow& row) {
   auto job = job_from_row(row);
   const std::string where = "job " + std::to_string(row.id) + ": ";
   job->begin_rebuild();
-  if (job->guide()) restore_guide(*job);
+  if (job->sequencer().builder()) restore_guide(*job);
   // An adaptive job's decided passes first: its results are checked against them.
   store.for_each_pass_plan(row.id, [&](uint32_t pass, std::string&& data) {
     std::vector<uint32_t> counts;
@@ -235,7 +235,7 @@ void Coordinator::Impl::save_decisions(JobState& job) {
 }
 
 void Coordinator::Impl::save_pass_plans(JobState& job) {
-  for (JobState::DecidedPass& d : job.take_new_plans()) {
+  for (PassSequencer::DecidedPass& d : job.take_new_plans()) {
     log_event(spdlog::level::info, "job.pass_planned", {{"job", job.id()}, {"pass", d.pass}, {"seconds", d.seconds}});
     // Retried until stored, ahead of the leases appended after it: a lease of the pass is only
     // handed out once its counts are durable.
@@ -248,29 +248,29 @@ void Coordinator::Impl::save_pass_plans(JobState& job) {
 
 void Coordinator::Impl::restore_guide(JobState& job) {
   std::vector<std::string> hashes = store.guides(job.id());
-  if (hashes.empty()) return;  // (not even its first tree was stored: it is made again)
+  if (hashes.empty()) return;  // (not even its first artifact was stored: it is made again)
   std::string bytes, error;
   try {
     bytes = read_file(guide_path(hashes.back()));
   } catch (const std::exception& e) {
     error = e.what();
   }
-  auto tree = std::make_shared<SpatialTree>();
-  if (sha256_hex(bytes) != hashes.back() || !decode_guide(bytes, *tree, error))
+  std::shared_ptr<const Artifact> latest;
+  if (sha256_hex(bytes) == hashes.back()) latest = job.sequencer().builder()->decode(bytes, error);
+  if (!latest)
     throw std::runtime_error("job " + std::to_string(job.id()) + ": its stored guide " + hashes.back() +
                              " is missing or corrupt " + error);
-  const uint32_t next = uint32_t(hashes.size() - 1);  // the pass it trains (if it trains one)
-  job.restore_guide(std::move(hashes), std::move(tree));
-  if (job.guide()->trains(next))
-    store.for_each_training(job.id(), next, [&](std::string&& records) { job.restore_training(records); });
+  job.restore_artifacts(std::move(hashes), std::move(latest));
+  for (uint32_t pass : job.passes_feeding_next())
+    store.for_each_training(job.id(), pass,
+                            [&](uint32_t tile, std::string&& records) { job.restore_records(pass, tile, records); });
 }
 
 void Coordinator::Impl::save_guides(JobState& job) {
-  while (auto made = job.take_tree_to_store()) {
-    background.push([this, id = job.id(), iteration = made->first, tree = made->second,
-                     barrier = job.guide()->end_seconds()] {
+  while (auto made = job.take_artifact()) {
+    background.push([this, id = job.id(), made = std::move(*made)] {
       const auto t0 = std::chrono::steady_clock::now();
-      const std::string bytes = encode_guide(*tree), hash = sha256_hex(bytes);
+      const std::string bytes = made.artifact->encode(), hash = sha256_hex(bytes);
       std::string error;
       try {
         write_file_durably(guide_path(hash), bytes);
@@ -287,13 +287,13 @@ void Coordinator::Impl::save_guides(JobState& job) {
         return;
       }
       // Retried until stored, ahead of the leases appended after it: a lease that renders with
-      // the tree is handed out only once its row is durable.
-      (void)commits.append([id, iteration, hash](Store& st) { st.save_guide(id, iteration, hash); },
+      // the artifact is handed out only once its row is durable.
+      (void)commits.append([id, iteration = made.iteration, hash](Store& st) { st.save_guide(id, iteration, hash); },
                            GroupCommit::Retry::UntilDurable);
       log_event(spdlog::level::info, "job.guide_stored",
-                {{"job", id}, {"iteration", iteration}, {"leaves", tree->leaf_count()}, {"tree_bytes", tree->bytes()},
-                 {"bytes", bytes.size()}, {"barrier_seconds", barrier}, {"seconds", seconds}});
-      job.guide_stored(iteration, hash);
+                {{"job", id}, {"iteration", made.iteration}, {"memory_bytes", made.artifact->memory_bytes()},
+                 {"bytes", bytes.size()}, {"barrier_seconds", made.seconds}, {"seconds", seconds}});
+      job.artifact_stored(made.iteration, hash);
       work_cv.notify_all();
     });
   }

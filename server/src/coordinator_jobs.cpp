@@ -319,7 +319,7 @@ JobStatus Coordinator::Impl::status_of(const JobState& job) const {
   s.target_error = p.settings.target_error;
   s.spp_done = job.spp_complete();
   s.stopped_at_target = job.converged();
-  if (const JobGuide* g = job.guide()) s.guide = JobStatus::Guide{job.guide_iterations(), g->tree_leaves(), g->tree_bytes()};
+  if (const GuideTraining* g = job.guide()) s.guide = JobStatus::Guide{job.guide_iterations(), g->tree_leaves(), g->tree_bytes()};
   return s;
 }
 

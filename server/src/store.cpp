@@ -333,10 +333,10 @@ void Store::save_training(uint64_t job, uint32_t tile, uint32_t pass, const std:
       .bind(int64_t(job)).bind(int64_t(pass)).bind(int64_t(tile)).blob(records).step();
 }
 
-void Store::for_each_training(uint64_t job, uint32_t pass, const std::function<void(std::string&&)>& fn) {
-  Stmt st(rd_, "SELECT data FROM training WHERE job = ? AND pass = ? ORDER BY tile");
+void Store::for_each_training(uint64_t job, uint32_t pass, const std::function<void(uint32_t, std::string&&)>& fn) {
+  Stmt st(rd_, "SELECT tile, data FROM training WHERE job = ? AND pass = ? ORDER BY tile");
   st.bind(int64_t(job)).bind(int64_t(pass));
-  while (st.step()) fn(st.s(0));
+  while (st.step()) fn(uint32_t(st.i(0)), st.s(1));
 }
 
 void Store::for_each_result(uint64_t job, const std::function<void(ResultRow&&)>& fn, bool with_data) {

@@ -2,7 +2,7 @@
 // bump map (the bathroom's floor tiles) on a small rendered scene.
 #include "bsdf/perturbed_test_util.h"
 #include "test_support.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 #include "tessera/scene/load_context.h"
 
 #include "bsdf/bsdf_test_util.h"

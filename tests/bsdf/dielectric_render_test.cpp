@@ -5,7 +5,7 @@
 #include "render/scene_builders.h"
 #include "tessera/bsdf/dielectric.h"
 #include "tessera/light/constant.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 
 #include <gtest/gtest.h>
 

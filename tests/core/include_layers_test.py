@@ -2,8 +2,8 @@
 """Each folder of common/ includes only its own headers and those of the folders below it.
 
 The layers, bottom first: core; image and guiding (core only); accel; render (the interfaces, the
-scene and its light selection); scene (the loader's description); the plugins (bsdf, light, medium,
-shape, texture), denoise and tools. A new include that points upwards fails here with its file and
+scene and its light selection); sequence (the pass sequencer and the render driver) and scene (the
+loader's description); the plugins (bsdf, light, medium, shape, texture), denoise and tools. A new include that points upwards fails here with its file and
 line, before it turns into a cycle.
 """
 import re
@@ -16,6 +16,7 @@ ALLOWED = {
     "guiding": {"core"},
     "accel": {"core"},
     "render": {"core", "image", "guiding", "accel"},
+    "sequence": {"core", "image", "guiding", "accel", "render"},
     "scene": {"core", "image", "guiding", "accel", "render"},
     "denoise": {"core", "image", "render"},
     "tools": {"core", "accel"},

@@ -77,7 +77,7 @@ TEST(AdaptiveJob, UnitsInAnyOrderStitchToTheLocalAdaptiveRender) {
       ASSERT_TRUE(job.add_result(u, std::move(tile), 1));
       EXPECT_EQ(job.done_samples(), samples) << "progress counts the samples taken";
     }
-    for (const JobState::DecidedPass& d : job.take_new_plans()) decided.push_back(d.pass);
+    for (const PassSequencer::DecidedPass& d : job.take_new_plans()) decided.push_back(d.pass);
   }
   EXPECT_EQ(decided, (std::vector<uint32_t>{4, 5}));
   ASSERT_TRUE(job.complete());

@@ -7,7 +7,7 @@
 #include "tessera/farm/job_scene.h"
 #include "tessera/farm/tile_result.h"
 #include "tessera/image/image.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 #include "tessera/scene/load_context.h"
 #include "tessera/scene/scene_desc.h"
 #include "tessera/server/coordinator.h"

@@ -5,7 +5,7 @@
 #include "tessera/farm/bundle.h"
 #include "tessera/farm/job_scene.h"
 #include "tessera/image/image.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 #include "tessera/client/farm_api.h"
 #include "test_support.h"
 
@@ -245,9 +245,7 @@ inline Image local_render(const std::string& scene, const JobSettings& settings)
   rs.tile_size = 32;  // deliberately not the farm's tile size
   rs.target_error = settings.target_error;
   rs.adaptive = settings.adaptive;
-  const IntegratorSettings& integrator = loaded.loaded.scene->integrator;
-  rs.guiding = settings.guiding.value_or(integrator.guiding.has_value());
-  if (integrator.guiding) rs.guiding_settings = *integrator.guiding;
+  rs.guiding = settings.guiding;  // (unset: as the scene's integrator says, as the coordinator decides)
   return render(*loaded.loaded.scene, rs).to_image();
 }
 

@@ -3,7 +3,7 @@
 // render()'s with guiding, for any order of results and across restarts.
 #include "coordinator_fixture.h"
 #include "job_state.h"
-#include "tessera/farm/guide_artifact.h"
+#include "tessera/sequence/guide_artifact.h"
 #include "tessera/farm/sha256.h"
 #include "tessera/image/image.h"
 
@@ -67,12 +67,13 @@ Film local_guided_render(const Scene& scene, uint32_t seed, bool adaptive = fals
 struct Guides {
   std::map<std::string, SpatialTree> by_hash;
   void store_new(JobState& job) {
-    while (auto made = job.take_tree_to_store()) {
-      const std::string bytes = encode_guide(*made->second), hash = sha256_hex(bytes);
+    while (auto made = job.take_artifact()) {
+      const auto& tree = static_cast<const GuideArtifact&>(*made->artifact).tree();
+      const std::string bytes = made->artifact->encode(), hash = sha256_hex(bytes);
       std::string error;
       ASSERT_TRUE(decode_guide(bytes, by_hash[hash], error)) << error;
-      EXPECT_TRUE(by_hash[hash] == *made->second) << "a guide decodes to the tree it encodes";
-      job.guide_stored(made->first, hash);
+      EXPECT_TRUE(by_hash[hash] == tree) << "a guide decodes to the tree it encodes";
+      job.artifact_stored(made->iteration, hash);
     }
   }
 };

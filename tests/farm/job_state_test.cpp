@@ -2,7 +2,7 @@
 // give the film `render()` gives, bit for bit.
 #include "job_state.h"
 #include "tessera/farm/job_scene.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 #include "tessera/scene/scene_desc.h"
 
 #include <gtest/gtest.h>

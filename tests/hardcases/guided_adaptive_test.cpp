@@ -21,7 +21,7 @@ RenderSettings guided_adaptive(int spp, uint32_t seed) {
   RenderSettings s = hard_settings(spp, seed);
   s.guiding = true;
   s.adaptive = true;
-  s.guiding_settings.spatial_threshold = 500;  // (tiny images: let the tree split anyway)
+  s.guiding_settings.emplace().spatial_threshold = 500;  // (tiny images: let the tree split anyway)
   return s;
 }
 
@@ -74,7 +74,7 @@ TEST(HardGuidedAdaptive, ATreeThatCannotSplit) {
   auto scene = mixed_scene();
   ASSERT_TRUE(scene);
   RenderSettings s = guided_adaptive(512, 46);
-  s.guiding_settings.max_bytes = 1;  // below a single leaf: the root stays the only leaf
+  s.guiding_settings->max_bytes = 1;  // below a single leaf: the root stays the only leaf
   expect_agrees(*scene, s, "one leaf");
 }
 

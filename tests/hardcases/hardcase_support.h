@@ -4,7 +4,7 @@
 
 #include "tessera/image/image.h"
 #include "tessera/image/image_compare.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 #include "tessera/scene/load_context.h"
 #include "tessera/scene/scene_desc.h"
 

@@ -9,7 +9,7 @@
 // by Mitsuba 3, which had to substitute some models (APPROX items in each reference's README).
 #include "tessera/image/image.h"
 #include "tessera/image/image_compare.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 #include "tessera/scene/load_context.h"
 #include "tessera/scene/scene_desc.h"
 #include "test_support.h"

@@ -2,7 +2,7 @@
 // exactly what is unsupported; cornell-box has nothing unsupported at all.
 #include "tessera/image/image.h"
 #include "tessera/image/image_compare.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 #include "tessera/scene/load_context.h"
 #include "tessera/scene/scene_desc.h"
 #include "test_support.h"

@@ -6,7 +6,7 @@
 #include "tessera/bsdf/diffuse.h"
 #include "tessera/core/hash.h"
 #include "tessera/light/area.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 #include "tessera/render/scene.h"
 #include "tessera/scene/load_context.h"
 #include "tessera/scene/scene_desc.h"

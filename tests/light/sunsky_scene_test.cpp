@@ -5,7 +5,7 @@
 #include "tessera/light/sunsky.h"
 #include "tessera/light/sunsky/hosek_sky.h"
 #include "tessera/light/sunsky/sun_spectrum.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 #include "tessera/scene/load_context.h"
 #include "tessera/scene/scene_desc.h"
 #include "test_support.h"

@@ -6,7 +6,7 @@
 // threads or tiles.
 #include "image_agreement.h"
 #include "scene_builders.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 
 #include <gtest/gtest.h>
 
@@ -42,7 +42,7 @@ TEST(AdaptiveRender, ConvergesToTheUniformImage) {
     if (std::string(name) == "window") {
       RenderSettings both = adaptive(512, 33);
       both.guiding = true;
-      both.guiding_settings.spatial_threshold = 500;  // (a tiny image: let the tree split anyway)
+      both.guiding_settings.emplace().spatial_threshold = 500;  // (a tiny image: let the tree split anyway)
       (void)expect_same_expectation(render(*scene, both), plain, 8, 4.0, "window guided + adaptive vs uniform");
     }
   }

@@ -2,7 +2,7 @@
 // the depth of a plane, features followed through a perfect mirror; the same bits for any tiling,
 // the beauty image unchanged by asking for them; half A and half B independent.
 #include "scene_builders.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 // Film crop windows: a cropped render equals the same pixels of the full render, bit for bit (each
 // pixel's value depends only on scene, pixel, sample index and seed).
 #include "scene_builders.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 
 #include <gtest/gtest.h>
 

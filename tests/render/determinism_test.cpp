@@ -1,6 +1,6 @@
 // Bit-identical films whatever the thread count, tile size or machine a tile pass ran on.
 #include "scene_builders.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 #include "tessera/render/sampler.h"
 
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
 #include "tessera/render/film.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 
 #include <gtest/gtest.h>
 

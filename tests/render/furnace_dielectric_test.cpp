@@ -8,7 +8,7 @@
 #include "scene_builders.h"
 #include "tessera/bsdf/dielectric.h"
 #include "tessera/light/constant.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 
 #include <gtest/gtest.h>
 

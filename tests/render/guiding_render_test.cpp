@@ -4,7 +4,7 @@
 // and with guiding off nothing changes.
 #include "image_agreement.h"
 #include "scene_builders.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 
 #include <gtest/gtest.h>
 
@@ -17,7 +17,7 @@ RenderSettings guided(int spp, uint32_t seed, int threads = 2, int tile_size = 1
   RenderSettings s = render_settings(spp, seed, tile_size);
   s.threads = threads;
   s.guiding = true;
-  s.guiding_settings.spatial_threshold = 500;  // (a tiny image: let the tree split anyway)
+  s.guiding_settings.emplace().spatial_threshold = 500;  // (a tiny image: let the tree split anyway)
   return s;
 }
 
@@ -57,7 +57,7 @@ TEST(GuidedRender, TheImageIsMadeOfThePassesAfterTraining) {
   const Film discarded = render(*scene, s, {}, &stats);
   EXPECT_EQ(discarded.pixel({5, 5}).count, 9u);
   EXPECT_EQ(stats.counters.samples, 16u * uint64_t(discarded.width() * discarded.height()));
-  s.guiding_settings.discard_training = false;
+  s.guiding_settings->discard_training = false;
   EXPECT_EQ(render(*scene, s).pixel({5, 5}).count, 16u);
 }
 

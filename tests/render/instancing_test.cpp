@@ -2,7 +2,7 @@
 // to the image of its flattened twin, where every member is written out with the composed
 // transform, and renders to the same bits for any thread count and tile size.
 #include "image_agreement.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 #include "tessera/scene/load_context.h"
 #include "tessera/scene/scene_desc.h"
 

@@ -1,7 +1,7 @@
 // Integrators against closed-form answers.
 #include "scene_builders.h"
 #include "tessera/light/constant.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 
 #include <gtest/gtest.h>
 

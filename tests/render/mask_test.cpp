@@ -6,7 +6,7 @@
 #include "tessera/bsdf/mask.h"
 #include "tessera/core/hash.h"
 #include "tessera/image/image.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 #include "tessera/scene/load_context.h"
 #include "tessera/texture/bitmap.h"
 

@@ -1,7 +1,7 @@
 // Motion blur: a sphere moving across an orthographic view covers each pixel centre for the
 // analytic fraction of the shutter; scenes where nothing moves render exactly as without motion.
 #include "scene_builders.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 #include "tessera/scene/load_context.h"
 #include "tessera/scene/scene_desc.h"
 

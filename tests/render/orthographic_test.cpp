@@ -1,7 +1,7 @@
 // orthographic sensor: the ray grid (origins on the image plane, one direction), the factory, and
 // a render whose projected size and position are analytic.
 #include "scene_builders.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 #include "tessera/scene/load_context.h"
 #include "tessera/scene/scene_desc.h"
 

@@ -6,7 +6,7 @@
 #include "tessera/light/area.h"
 #include "tessera/light/point.h"
 #include "tessera/render/film.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 #include "tessera/render/scene.h"
 #include "tessera/scene/load_context.h"
 #include "tessera/scene/scene_desc.h"

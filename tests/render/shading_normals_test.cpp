@@ -5,7 +5,7 @@
 // Mitsuba 0.6 does.
 #include "scene_builders.h"
 #include "tessera/light/constant.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 
 #include <gtest/gtest.h>
 

@@ -7,7 +7,7 @@
 #include "image_agreement.h"
 #include "scene_builders.h"
 #include "tessera/render/integrator.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 #include "tessera/scene/load_context.h"
 #include "tessera/scene/scene_desc.h"
 

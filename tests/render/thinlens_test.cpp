@@ -2,7 +2,7 @@
 // render (a point in the focus plane stays sharp; off it, the blur disk has the thin-lens radius).
 #include "scene_builders.h"
 #include "tessera/core/hash.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 #include "tessera/scene/load_context.h"
 #include "tessera/scene/scene_desc.h"
 

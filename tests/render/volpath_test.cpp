@@ -4,7 +4,7 @@
 #include "scene_builders.h"
 #include "tessera/bsdf/null.h"
 #include "tessera/light/constant.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 #include "tessera/worker/scene_cache.h"
 
 #include "tessera/farm/bundle.h"
-#include "tessera/farm/guide_artifact.h"
+#include "tessera/sequence/guide_artifact.h"
 #include "tessera/farm/job_scene.h"
 #include "tessera/farm/sha256.h"
 

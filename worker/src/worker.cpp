@@ -3,7 +3,7 @@
 #include "tessera/farm/build_fingerprint.h"
 #include "tessera/farm/job_scene.h"
 #include "tessera/farm/tile_result.h"
-#include "tessera/render/renderer.h"
+#include "tessera/sequence/renderer.h"
 
 #include <spdlog/spdlog.h>
 

@@ -7,6 +7,7 @@
 #include "tessera/farm/protocol.h"
 #include "tessera/farm/tile_result.h"
 #include "tessera/guiding/spatial_tree.h"
+#include "tessera/sequence/path_program.h"
 #include "tessera/scene/load_context.h"
 
 #include <string>
@@ -24,12 +25,13 @@ struct JobPlan {
   bool ldr = false;              // ldrfilm: PNG output uses gamma/exposure below
   float gamma = -1.f, exposure = 0.f;
   /// A guided job: the SD-tree as render() starts it (over the scene's bounds) and its settings.
-  struct Guide {
-    Bounds3 bounds;
-    GuidingSettings settings;
-  };
+  using Guide = GuidePlan;
   std::optional<Guide> guide;
 };
+
+/// The job's path-tracer options (sequence/path_program.h): the sequencer the coordinator runs
+/// is the one `tessera render` runs with the same settings.
+PathProgramOptions path_options(const JobPlan& plan);
 
 struct LoadedJobScene {
   SceneDesc desc;

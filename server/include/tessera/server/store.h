@@ -120,8 +120,8 @@ class Store {
   std::set<std::string> guide_hashes();
   /// Stores a training unit's records (guiding/tree_io.h bytes) until its pass's tree is stored.
   void save_training(uint64_t job, uint32_t tile, uint32_t pass, const std::string& records);
-  /// Calls `fn(bytes)` for each stored training record of the job's pass `pass`, by tile.
-  void for_each_training(uint64_t job, uint32_t pass, const std::function<void(std::string&&)>& fn);
+  /// Calls `fn(tile, bytes)` for each stored training record of the job's pass `pass`, by tile.
+  void for_each_training(uint64_t job, uint32_t pass, const std::function<void(uint32_t, std::string&&)>& fn);
   /// Leases issued for a pass after that pass had been acknowledged (should be 0: the measure the
   /// restart test reads).
   uint64_t reissued_after_ack(uint64_t job);

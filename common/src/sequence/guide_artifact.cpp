@@ -1,4 +1,4 @@
-#include "tessera/farm/guide_artifact.h"
+#include "tessera/sequence/guide_artifact.h"
 
 #include "tessera/guiding/tree_io.h"
 

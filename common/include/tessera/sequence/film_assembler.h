@@ -1,0 +1,109 @@
+// Results into films, in an order the program fixes, whatever order they arrive in.
+//
+// - A tile's results (FilmTile) enter their pass's film in pass order, one tile at a time: a
+//   pixel's sums are (sums of pass 0) + (sums of pass 1) + ..., as film.h promises. A result that
+//   arrives before an earlier pass of its tile is held until that one is in.
+// - Paths units' results (SplatSums) are folded into their film's splat layer in (pass, unit)
+//   order, each unit's splats in the order it made them; an early one is held likewise.
+// - A pass with film kNoFilm enters nothing, but keeps its place in the order.
+// - The image (FilmCombine, pass_program.h): each film's pixel is its mean plus its splat sum over
+//   the light paths per pixel folded into it (a light tracer's splat scale); with Sum that is the
+//   image, with InverseVariance the films' images are averaged with weights 1 / (relMSE + 1e-12),
+//   relMSE the film's estimate (noise_estimate.h), 0 for a film without one (all equal when no
+//   film has one). The AOV layers are the last film's (the one the last pass enters).
+//
+// Films are allocated on the first result (a queued farm job holds none) and can be released once
+// the image is written. Not thread-safe: the caller serialises.
+#pragma once
+
+#include "tessera/image/image.h"
+#include "tessera/render/film.h"
+#include "tessera/render/noise_estimate.h"
+#include "tessera/sequence/pass_program.h"
+#include "tessera/sequence/splat_sums.h"
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <vector>
+
+namespace tessera {
+
+class FilmAssembler {
+ public:
+  FilmAssembler(const PassProgram& program, std::vector<TileRect> tiles, const TileRect& window, int full_width,
+                int full_height, bool aovs);
+
+  /// Tile `tile`'s result of Tile pass `pass` (each once).
+  void add_tile(uint32_t pass, uint32_t tile, FilmTile&& result);
+  /// Unit `index` of Paths pass `pass` (each once).
+  void add_splat(uint32_t pass, uint32_t index, SplatSums&& result);
+
+  /// The tile's next pass to enter its film (passes before it are in; the number of passes once
+  /// every one is).
+  uint32_t next_pass(uint32_t tile) const { return next_[tile]; }
+  /// Counts every change of the films' sums (a result entered or a tile restored).
+  uint64_t changes() const { return changes_; }
+  /// Counters of every result that entered.
+  const RenderCounters& counters() const { return counters_; }
+
+  bool allocated() const { return !films_.empty(); }
+  bool released() const { return released_; }
+  /// Frees the films (and held results) of a render whose image is written.
+  void release();
+  /// Film `f` (allocated()).
+  const Film& film(int f) const { return *films_[size_t(f)]; }
+  /// Moves film `f` out (a finished local render; the assembler is spent).
+  Film take_film(int f) { return std::move(*films_[size_t(f)]); }
+  int primary_film() const { return primary_; }
+
+  /// The estimate of the image's relMSE (Sum: film 0's; InverseVariance: 1 / the sum of the films'
+  /// weights); +inf before there is one.
+  NoiseEstimate noise() const;
+  /// The image by the program's rule (black before any result).
+  Image image() const;
+  /// Film `f`'s splat sums (3 per window pixel; empty before a splat arrived).
+  const std::vector<double>& splats(int f) const { return splats_[size_t(f)]; }
+  /// Film `f`'s own image (allocated()): its mean plus its splats over its light paths per pixel.
+  Image film_image(int f) const;
+  /// Rows [row_begin, row_end) of image() into `img` (the window's size): a large film converted a
+  /// band at a time. With InverseVariance, the weights are those of the films at the call.
+  void image_rows(Image& img, int row_begin, int row_end) const;
+  /// Rows of an AOV layer (aov.h) of the primary film, as Film::aov_rows.
+  void aov_rows(AovLayer layer, Image& img, int row_begin, int row_end) const;
+
+  // Checkpoints (a coordinator stores a tile's sums in place of its results): the tile's region of
+  // the primary film with the counters of the passes in it, and back.
+  FilmTile tile_region(uint32_t tile) const;
+  /// Rebuilding: the tile's sums over every pass before `next_pass` (their results are then never
+  /// added); adding them to a zero film reproduces the sums bit for bit.
+  void restore_tile(uint32_t tile, uint32_t next_pass, FilmTile&& sums);
+
+ private:
+  void allocate();
+  void enter_tile(uint32_t pass, uint32_t tile, FilmTile& result);
+  uint32_t next_tile_pass(uint32_t after) const;
+  uint64_t unit_paths(uint32_t pass, uint32_t index) const;
+  std::vector<double> weights() const;
+  void pixel_row(int f, int y, std::vector<float>& row) const;
+
+  PassProgram program_;
+  std::vector<TileRect> tiles_;
+  TileRect window_;
+  int full_width_, full_height_;
+  bool aovs_;
+  int primary_ = 0;
+  std::vector<std::unique_ptr<Film>> films_;
+  std::vector<std::vector<double>> splats_;  // per film: 3 per pixel once a splat arrived
+  std::vector<uint64_t> splat_paths_;        // per film: light paths folded into it
+  std::vector<uint32_t> next_;               // per tile
+  std::vector<RenderCounters> tile_counters_;  // per tile: of the passes in its film
+  std::map<std::pair<uint32_t, uint32_t>, FilmTile> held_tiles_;    // by (pass, tile)
+  std::map<std::pair<uint32_t, uint32_t>, SplatSums> held_splats_;  // by (pass, unit)
+  std::pair<uint32_t, uint32_t> next_splat_;                         // (pass, unit) folded next
+  RenderCounters counters_;
+  uint64_t changes_ = 0;
+  bool released_ = false;
+};
+
+}  // namespace tessera

@@ -1,0 +1,51 @@
+// The path tracer's passes: pass_schedule(spp) as Tile passes into one film, with the barriers
+// that a target error, adaptive sampling and path guiding add. `tessera render`, `tessera submit`
+// and the coordinator build a render's sequencer here, so they cannot disagree about it.
+#pragma once
+
+#include "tessera/core/bounds.h"
+#include "tessera/guiding/spatial_tree.h"
+#include "tessera/render/adaptive.h"
+#include "tessera/render/scene.h"
+#include "tessera/sequence/pass_program.h"
+#include "tessera/sequence/pass_sequencer.h"
+
+#include <optional>
+
+namespace tessera {
+
+/// A guided render's start: the SD-tree's bounds (the scene's) and guiding's settings.
+struct GuidePlan {
+  Bounds3 bounds;
+  GuidingSettings settings;
+};
+
+/// Whether and how a render of `scene` is guided: as asked (`requested`), else as its integrator
+/// says (a guided_path integrator is); only path and volpath over a scene with bounds are. The
+/// settings are `settings`, else the scene's guided_path integrator's, else the defaults. The one
+/// place this is decided.
+std::optional<GuidePlan> guide_plan(const Scene& scene, std::optional<bool> requested,
+                                    const std::optional<GuidingSettings>& settings = std::nullopt);
+
+/// What the path tracer asks of its passes: the settings `tessera render` and a farm job share.
+struct PathProgramOptions {
+  uint32_t spp = 0;
+  double target_error = 0;
+  bool adaptive = false;
+  AdaptiveSettings adaptive_settings;
+  std::optional<GuidePlan> guide;
+};
+
+/// The program: with a target error every pass after the first may stop the render. Adaptive: the
+/// passes that adaptive_pass() allows, and all after them, are barriers with adaptive counts.
+/// Guided: the training passes (guiding_trains_pass) render with the guide learned so far (pass p
+/// with iteration p) and feed the next, pass p > 0 waits for the guide it renders with, and every
+/// later pass renders with the last; with discard_training the training passes enter no film.
+/// Without a training pass (fewer than 2 samples a pixel) nothing is guided.
+PassProgram path_program(const PathProgramOptions& options);
+
+/// The sequencer of that program over `frame`, with the guide's training (guide_training.h) as its
+/// artifact builder when a pass is guided.
+PassSequencer path_sequencer(const PathProgramOptions& options, const SequenceFrame& frame);
+
+}  // namespace tessera

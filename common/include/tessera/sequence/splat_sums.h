@@ -1,0 +1,41 @@
+// A Paths unit's result (pass_program.h): what its light paths added to which pixels of the
+// window, in the order they added it. Sparse, since a range of paths reaches the camera at a
+// scattering of pixels; the sequencer folds units into a film's splat layer in (pass, unit) order,
+// so a pixel's sum is the same bits however the ranges were spread over threads or machines.
+#pragma once
+
+#include "tessera/core/rgb.h"
+#include "tessera/core/vec.h"
+#include "tessera/render/film.h"
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace tessera {
+
+struct SplatSums {
+  TileRect window;
+  std::vector<uint32_t> pixel;                // row-major index in `window`, per splat
+  std::vector<std::array<double, 3>> value;   // per splat
+  RenderCounters counters;
+
+  void reset(const TileRect& w) {
+    window = w;
+    pixel.clear();
+    value.clear();
+    counters = {};
+  }
+  /// Adds `v` to pixel `p` (inside the window). A non-finite value adds nothing and is counted.
+  void add(Vec2i p, Rgb v) {
+    if (!v.is_finite()) {
+      ++counters.nonfinite;
+      return;
+    }
+    pixel.push_back(uint32_t(size_t(p.y - window.y0) * size_t(window.width()) + size_t(p.x - window.x0)));
+    value.push_back({double(v.r), double(v.g), double(v.b)});
+  }
+  size_t size() const { return pixel.size(); }
+};
+
+}  // namespace tessera

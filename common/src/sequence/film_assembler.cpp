@@ -1,0 +1,220 @@
+#include "tessera/sequence/film_assembler.h"
+
+#include "tessera/core/check.h"
+
+#include <cmath>
+#include <limits>
+
+namespace tessera {
+
+FilmAssembler::FilmAssembler(const PassProgram& program, std::vector<TileRect> tiles, const TileRect& window,
+                             int full_width, int full_height, bool aovs)
+    : program_(program), tiles_(std::move(tiles)), window_(window), full_width_(full_width),
+      full_height_(full_height), aovs_(aovs) {
+  for (const PassSpec& p : program_.passes)
+    if (p.film != kNoFilm) primary_ = p.film;
+  next_.assign(tiles_.size(), next_tile_pass(0));
+  tile_counters_.assign(tiles_.size(), RenderCounters{});
+  uint32_t first_paths = 0;
+  while (first_paths < program_.passes.size() && program_.passes[first_paths].kind != UnitKind::Paths) ++first_paths;
+  next_splat_ = {first_paths, 0};
+}
+
+// The first Tile pass at or after `after`.
+uint32_t FilmAssembler::next_tile_pass(uint32_t after) const {
+  while (after < program_.passes.size() && program_.passes[after].kind != UnitKind::Tile) ++after;
+  return after;
+}
+
+void FilmAssembler::allocate() {
+  if (!films_.empty() || released_) return;
+  for (int f = 0; f < program_.films; ++f)
+    films_.push_back(std::make_unique<Film>(window_, full_width_, full_height_, aovs_));
+  splats_.resize(size_t(program_.films));
+  splat_paths_.assign(size_t(program_.films), 0);
+}
+
+void FilmAssembler::release() {
+  films_.clear();
+  splats_.clear();
+  held_tiles_.clear();
+  held_splats_.clear();
+  released_ = true;
+}
+
+void FilmAssembler::enter_tile(uint32_t pass, uint32_t tile, FilmTile& result) {
+  const int f = program_.passes[pass].film;
+  if (f != kNoFilm && !films_.empty()) films_[size_t(f)]->add_tile(result);
+  tile_counters_[tile] += result.counters;
+  counters_ += result.counters;
+  ++changes_;
+  next_[tile] = next_tile_pass(pass + 1);
+}
+
+void FilmAssembler::add_tile(uint32_t pass, uint32_t tile, FilmTile&& result) {
+  TESSERA_CHECK(pass < program_.passes.size() && program_.passes[pass].kind == UnitKind::Tile);
+  allocate();
+  if (released_) {  // (a late result of a render whose image is written: counted only)
+    counters_ += result.counters;
+    return;
+  }
+  if (pass != next_[tile]) {
+    held_tiles_.emplace(std::pair{pass, tile}, std::move(result));
+    return;
+  }
+  enter_tile(pass, tile, result);
+  for (auto it = held_tiles_.find({next_[tile], tile}); it != held_tiles_.end();
+       it = held_tiles_.find({next_[tile], tile})) {
+    enter_tile(it->first.first, tile, it->second);
+    held_tiles_.erase(it);
+  }
+}
+
+uint64_t FilmAssembler::unit_paths(uint32_t pass, uint32_t index) const {
+  const uint64_t paths = uint64_t(window_.area()) * program_.passes[pass].samples;
+  const uint64_t begin = uint64_t(index) * program_.paths_per_unit;
+  return begin >= paths ? 0 : std::min(program_.paths_per_unit, paths - begin);
+}
+
+void FilmAssembler::add_splat(uint32_t pass, uint32_t index, SplatSums&& result) {
+  TESSERA_CHECK(pass < program_.passes.size() && program_.passes[pass].kind == UnitKind::Paths);
+  TESSERA_CHECK(result.window == window_ && result.pixel.size() == result.value.size());
+  allocate();
+  if (released_) {
+    counters_ += result.counters;
+    return;
+  }
+  held_splats_.emplace(std::pair{pass, index}, std::move(result));
+  for (auto it = held_splats_.find(next_splat_); it != held_splats_.end(); it = held_splats_.find(next_splat_)) {
+    const auto [p, i] = it->first;
+    const int f = program_.passes[p].film;
+    const SplatSums& s = it->second;
+    if (f != kNoFilm && !films_.empty()) {
+      std::vector<double>& layer = splats_[size_t(f)];
+      if (layer.empty()) layer.assign(size_t(window_.area()) * 3, 0.0);
+      for (size_t k = 0; k < s.pixel.size(); ++k)
+        for (int c = 0; c < 3; ++c) layer[size_t(s.pixel[k]) * 3 + size_t(c)] += s.value[k][size_t(c)];
+      splat_paths_[size_t(f)] += unit_paths(p, i);
+    }
+    counters_ += s.counters;
+    ++changes_;
+    held_splats_.erase(it);
+    next_splat_ = unit_paths(p, i + 1) > 0 ? std::pair{p, i + 1} : std::pair{p + 1, 0u};
+    while (next_splat_.first < program_.passes.size() && program_.passes[next_splat_.first].kind != UnitKind::Paths)
+      ++next_splat_.first;
+  }
+}
+
+NoiseEstimate FilmAssembler::noise() const {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  if (films_.empty()) return {kInf, 0};
+  if (program_.combine == FilmCombine::Sum) return estimate_noise(*films_[0]);
+  double total = 0;
+  uint64_t pixels = 0;
+  for (const auto& film : films_) {
+    const NoiseEstimate e = estimate_noise(*film);
+    if (std::isfinite(e.rel_mse)) total += 1.0 / (e.rel_mse + 1e-12), pixels = e.pixels;
+  }
+  return total > 0 ? NoiseEstimate{1.0 / total, pixels} : NoiseEstimate{kInf, 0};
+}
+
+std::vector<double> FilmAssembler::weights() const {
+  std::vector<double> w(films_.size(), 0.0);
+  if (program_.combine == FilmCombine::Sum) {
+    w[0] = 1;
+    return w;
+  }
+  double total = 0;
+  for (size_t f = 0; f < films_.size(); ++f) {
+    const double e = estimate_noise(*films_[f]).rel_mse;
+    w[f] = std::isfinite(e) ? 1.0 / (e + 1e-12) : 0.0;
+    total += w[f];
+  }
+  for (double& x : w) x = total > 0 ? x / total : 1.0 / double(w.size());
+  return w;
+}
+
+// Film f's image over row y of the window (3 floats per pixel): its mean plus its splats.
+void FilmAssembler::pixel_row(int f, int y, std::vector<float>& row) const {
+  const Film& film = *films_[size_t(f)];
+  const std::vector<double>& layer = splats_[size_t(f)];
+  const double per_pixel = double(splat_paths_[size_t(f)]) / double(window_.area());
+  for (int x = window_.x0; x < window_.x1; ++x) {
+    const Rgb m = film.mean({x, y});
+    const size_t i = size_t(y - window_.y0) * size_t(window_.width()) + size_t(x - window_.x0);
+    for (int c = 0; c < 3; ++c) {
+      double v = m[c];
+      if (!layer.empty() && per_pixel > 0) v += layer[i * 3 + size_t(c)] / per_pixel;
+      row[size_t(x - window_.x0) * 3 + size_t(c)] = float(v);
+    }
+  }
+}
+
+Image FilmAssembler::image() const {
+  Image img(window_.width(), window_.height(), 3);
+  image_rows(img, 0, window_.height());
+  return img;
+}
+
+Image FilmAssembler::film_image(int f) const {
+  Image img(window_.width(), window_.height(), 3);
+  std::vector<float> row(size_t(window_.width()) * 3);
+  for (int y = window_.y0; y < window_.y1; ++y) {
+    pixel_row(f, y, row);
+    for (int x = 0; x < window_.width(); ++x)
+      img.set_rgb(x, y - window_.y0, Rgb(row[size_t(x) * 3], row[size_t(x) * 3 + 1], row[size_t(x) * 3 + 2]));
+  }
+  return img;
+}
+
+void FilmAssembler::image_rows(Image& img, int row_begin, int row_end) const {
+  TESSERA_CHECK(img.width() == window_.width() && img.height() == window_.height() && row_begin >= 0 &&
+                row_end <= window_.height());
+  if (films_.empty()) return;  // (black, as allocated)
+  const std::vector<double> w = weights();
+  std::vector<float> row(size_t(window_.width()) * 3), sum(row.size());
+  for (int y = window_.y0 + row_begin; y < window_.y0 + row_end; ++y) {
+    std::fill(sum.begin(), sum.end(), 0.f);
+    for (size_t f = 0; f < films_.size(); ++f) {
+      if (w[f] == 0) continue;
+      pixel_row(int(f), y, row);
+      for (size_t i = 0; i < row.size(); ++i) sum[i] = w.size() == 1 ? row[i] : float(double(sum[i]) + w[f] * row[i]);
+    }
+    for (int x = 0; x < window_.width(); ++x)
+      img.set_rgb(x, y - window_.y0, Rgb(sum[size_t(x) * 3], sum[size_t(x) * 3 + 1], sum[size_t(x) * 3 + 2]));
+  }
+}
+
+void FilmAssembler::aov_rows(AovLayer layer, Image& img, int row_begin, int row_end) const {
+  if (films_.empty()) return;
+  const Film& film = *films_[size_t(primary_)];
+  if (film.has_aovs() || layer == AovLayer::Variance) film.aov_rows(layer, img, row_begin, row_end);
+}
+
+FilmTile FilmAssembler::tile_region(uint32_t tile) const {
+  const TileRect& r = tiles_[tile];
+  FilmTile out(r, aovs_);
+  if (!films_.empty()) {
+    const Film& film = *films_[size_t(primary_)];
+    std::vector<PixelSums>& px = out.mutable_pixels();
+    for (int y = r.y0; y < r.y1; ++y)
+      for (int x = r.x0; x < r.x1; ++x) {
+        const size_t i = size_t(y - r.y0) * size_t(r.width()) + size_t(x - r.x0);
+        px[i] = film.pixel({x, y});
+        if (out.has_aovs()) out.mutable_aovs()[i] = film.aov({x, y});
+      }
+  }
+  out.counters = tile_counters_[tile];
+  return out;
+}
+
+void FilmAssembler::restore_tile(uint32_t tile, uint32_t next_pass, FilmTile&& sums) {
+  allocate();
+  if (!films_.empty()) films_[size_t(primary_)]->add_tile(sums);
+  counters_ += sums.counters;
+  tile_counters_[tile] = sums.counters;
+  next_[tile] = next_tile_pass(next_pass);
+  ++changes_;
+}
+
+}  // namespace tessera

@@ -1,0 +1,53 @@
+#include "tessera/sequence/pass_program.h"
+
+#include <algorithm>
+
+namespace tessera {
+
+const char* unit_kind_name(UnitKind kind) { return kind == UnitKind::Tile ? "tile" : "paths"; }
+
+const char* film_combine_name(FilmCombine combine) {
+  return combine == FilmCombine::Sum ? "sum" : "inverse_variance";
+}
+
+namespace {
+
+std::string pass_error(const PassProgram& program, size_t p, const std::vector<bool>& used_before) {
+  const PassSpec& pass = program.passes[p];
+  const std::string where = "pass " + std::to_string(p) + ": ";
+  if (pass.film != kNoFilm && (pass.film < 0 || pass.film >= program.films)) return where + "no such film";
+  if ((pass.adaptive || pass.may_stop) && !pass.barrier) return where + "decides at no barrier";
+  if (pass.kind == UnitKind::Paths && (pass.adaptive || pass.tile_state))
+    return where + "a Paths pass has no per-pixel counts or state";
+  if (pass.tile_state && (p == 0 || program.passes[p - 1].kind != UnitKind::Tile))
+    return where + "its per-pixel state comes from a Tile pass before it";
+  if (pass.adaptive && p == 0) return where + "the first pass has no film to adapt to";
+  if (pass.uses && *pass.uses > 0 && !used_before[*pass.uses] && !pass.barrier)
+    return where + "renders with a new artifact without waiting for it (a barrier)";
+  if (pass.feeds && pass.uses && *pass.feeds <= *pass.uses) return where + "feeds an artifact it renders with";
+  return {};
+}
+
+}  // namespace
+
+std::string program_error(const PassProgram& program) {
+  if (program.films < 1) return "a program has at least one film";
+  if (program.combine == FilmCombine::Sum && program.films != 1) return "the Sum rule combines exactly one film";
+  if (program.paths_per_unit == 0) return "paths_per_unit is 0";
+  uint32_t max_artifact = 0;
+  for (const PassSpec& pass : program.passes) {
+    max_artifact = std::max(max_artifact, pass.uses.value_or(0));
+    max_artifact = std::max(max_artifact, pass.feeds.value_or(0));
+  }
+  std::vector<bool> used_before(size_t(max_artifact) + 1, false);
+  for (size_t p = 0; p < program.passes.size(); ++p) {
+    if (std::string e = pass_error(program, p, used_before); !e.empty()) return e;
+    if (program.passes[p].uses) used_before[*program.passes[p].uses] = true;
+    // A pixel's adaptive samples keep consecutive indices only if no uniform pass follows.
+    if (p > 0 && program.passes[p - 1].adaptive && !program.passes[p].adaptive)
+      return "pass " + std::to_string(p) + ": every pass after an adaptive one is adaptive";
+  }
+  return {};
+}
+
+}  // namespace tessera

@@ -1,0 +1,81 @@
+#include "tessera/sequence/renderer.h"
+
+#include "tessera/core/check.h"
+#include "tessera/render/integrator.h"
+#include "tessera/sequence/guide_training.h"
+#include "tessera/sequence/local_driver.h"
+#include "tessera/sequence/path_program.h"
+
+#include <chrono>
+
+namespace tessera {
+
+namespace {
+
+// The path tracer's units: tiles, guided by the artifact (SD-tree) the pass renders with.
+class PathUnits final : public UnitRenderer {
+ public:
+  PathUnits(const Scene& scene, uint32_t seed, bool aovs, GuideTraining* guide)
+      : scene_(scene), integrator_(make_integrator(scene.integrator)), seed_(seed), aovs_(aovs), guide_(guide) {}
+
+  void prepare(PassSequencer& sequencer, uint32_t pass) override {
+    // A training pass's units record straight into the next tree's sums (thread-safe records).
+    if (guide_ && sequencer.pass(pass).feeds) (void)guide_->recorder();
+  }
+
+  void render(const PassSequencer& sequencer, const UnitWork& work, UnitResult& result) override {
+    std::optional<PathGuide> guide;
+    if (work.uses) {
+      const auto& tree = static_cast<const GuideArtifact*>(sequencer.artifact(*work.uses))->tree();
+      guide = PathGuide{&tree, work.feeds ? &guide_->recorder() : nullptr, *work.uses > 0, work.feeds.has_value()};
+    }
+    const PassSamples samples = work.samples ? *work.samples : PassSamples::uniform(work.rect, work.sample_begin, work.sample_end);
+    render_tile(scene_, *integrator_, work.rect, samples, seed_, result.tile, guide ? &*guide : nullptr, aovs_);
+  }
+
+ private:
+  const Scene& scene_;
+  std::unique_ptr<Integrator> integrator_;
+  uint32_t seed_;
+  bool aovs_;
+  GuideTraining* guide_;
+};
+
+}  // namespace
+
+Film render(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress, RenderStats* stats) {
+  const auto start = std::chrono::steady_clock::now();
+  TESSERA_CHECK(settings.spp >= 0 && settings.tile_size > 0);
+  PathProgramOptions options{uint32_t(settings.spp), settings.target_error, settings.adaptive, settings.adaptive_settings,
+                             guide_plan(scene, settings.guiding, settings.guiding_settings)};
+  PassSequencer sequencer = path_sequencer(options, SequenceFrame{film_window(scene.film), scene.film.width,
+                                                                  scene.film.height, settings.tile_size, settings.aovs});
+  auto* training = dynamic_cast<GuideTraining*>(sequencer.builder());
+  PathUnits units(scene, settings.seed, settings.aovs, training);
+  RenderProgress prog;
+  prog.num_passes = int(sequencer.num_passes());
+  prog.tiles_total = int64_t(sequencer.num_units());
+  prog.spp = uint32_t(settings.spp);
+  run_locally(sequencer, units, settings.threads, [&](const PassSequencer& s, uint32_t pass) {
+    prog.pass = int(pass);
+    prog.tiles_done = int64_t(s.done_units());
+    prog.samples_done = s.spp_complete();
+    if (progress) progress(prog);
+  });
+  FilmAssembler& films = sequencer.films();
+  Film film = films.allocated() ? films.take_film(films.primary_film()) : Film(scene.film, settings.aovs);
+  film.add_counters(films.counters());
+  if (stats) {
+    stats->counters = films.counters();
+    stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    stats->spp_done = sequencer.stopped() ? sequencer.spp_complete() : uint32_t(settings.spp);
+    if (training && training->latest()) {
+      stats->guide_leaves = training->tree_leaves();
+      stats->guide_bytes = training->tree_bytes();
+    }
+    stats->noise_estimate = settings.target_error > 0 ? estimate_noise(film).rel_mse : 0;
+  }
+  return film;
+}
+
+}  // namespace tessera
