@@ -8,7 +8,9 @@ cd "$(dirname "$0")/.."
 out=${1:-out/demo.png}
 workers=${2:-2}
 
-bash scripts/install-deps.sh
+# What building and running the three programs needs, no more: the tests' browser, container tools
+# and test frameworks come with scripts/test.sh.
+bash scripts/install-deps.sh --build
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j"$(nproc 2>/dev/null || echo 2)" --target tessera tessera-server tessera-worker
 mkdir -p "$(dirname "$out")"

@@ -2,8 +2,9 @@
 # Installs the Debian 12 packages Tessera needs. Idempotent; run as root (or with sudo available).
 # Nothing is downloaded from anywhere but Debian's archive.
 #   install-deps.sh              build and every test (what CI and scripts/test.sh use)
-#   install-deps.sh --build      only what compiling tessera, tessera-server and tessera-worker needs
-#                                (the image's build stage: no browser, test framework or container tools)
+#   install-deps.sh --build      only what compiling and running tessera, tessera-server and
+#                                tessera-worker needs (scripts/demo.sh and the image's build stage: no
+#                                browser, test framework or container tools)
 #   install-deps.sh --runtime    only what the built programs load (the image's runtime stage)
 #   --list, --list-build, --list-runtime print a list instead of installing it
 set -euo pipefail

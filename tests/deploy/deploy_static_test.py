@@ -244,6 +244,10 @@ def check_install_modes(c, root):
     c.check(not build & TEST_ONLY, "install-deps.sh --build installs no test-only package",
             f"{sorted(build & TEST_ONLY)}")
     c.check({"build-essential", "cmake", "ninja-build"} <= build, "install-deps.sh --build installs a compiler, CMake and Ninja")
+    demo = open(os.path.join(root, "scripts", "demo.sh")).read()
+    c.check(re.search(r"^bash scripts/install-deps\.sh --build$", demo, re.M) is not None and
+            "install-deps.sh\n" not in demo and not re.search(r"install-deps\.sh\s*$", demo, re.M),
+            "scripts/demo.sh installs the build packages only (install-deps.sh --build: no browser, no container tools)")
     need = {"podman", "podman-compose", "debootstrap"}
     c.check(need <= full, "install-deps.sh (default, what CI runs) installs the container test's tools",
             f"missing {sorted(need - full)}")
