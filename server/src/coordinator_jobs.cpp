@@ -64,17 +64,6 @@ std::string read_file(const std::string& path) {
   return ss.str();
 }
 
-// Checked before the scene is loaded, so a flood of submissions costs no unpacking, and again
-// before the job is stored.
-Status Coordinator::Impl::check_active_jobs() const {
-  int active = submissions_in_flight;
-  for (const auto& [id, job] : jobs) active += is_terminal(job->phase) ? 0 : 1;
-  if (active < opt.max_active_jobs) return Status::success();
-  return make_error(Code::TooManyRequests, "too_many_jobs",
-                    std::to_string(active) + " jobs are queued or running; the limit is " +
-                        std::to_string(opt.max_active_jobs) + " (retry when some have finished)");
-}
-
 Result<SceneUpload> Coordinator::upload_scene(const std::string& bundle) {
   Impl& s = *impl_;
   if (bundle.size() > s.opt.max_upload_bytes)
@@ -87,8 +76,7 @@ Result<SceneUpload> Coordinator::upload_scene(const std::string& bundle) {
   try {
     if (!touch_bundle(s.bundle_path(hash))) write_file_durably(s.bundle_path(hash), bundle);
     s.store.add_scene(hash, bundle.size(), wall_seconds());
-    std::lock_guard<std::mutex> lock(s.mu);
-    s.counters.bytes_in += bundle.size();
+    s.metrics.counters.bytes_in += bundle.size();
   } catch (const std::exception& e) {
     return internal_error(e);
   }
@@ -109,8 +97,7 @@ Result<std::string> Coordinator::scene_bundle(const std::string& hash) {
   if (!path.ok()) return path.status;
   try {
     std::string bytes = read_file(path.value);
-    std::lock_guard<std::mutex> lock(impl_->mu);
-    impl_->counters.bytes_out += bytes.size();
+    impl_->metrics.counters.bytes_out += bytes.size();
     return bytes;
   } catch (const std::exception& e) {
     return internal_error(e);
@@ -123,8 +110,7 @@ Result<std::string> Coordinator::guide(const std::string& hash) {
   if (!fs::exists(path)) return make_error(Code::NotFound, "unknown_guide", "no guide " + hash);
   try {
     std::string bytes = read_file(path);  // (immutable once written: no lock)
-    std::lock_guard<std::mutex> lock(impl_->mu);
-    impl_->counters.bytes_out += bytes.size();
+    impl_->metrics.counters.bytes_out += bytes.size();
     return bytes;
   } catch (const std::exception& e) {
     return internal_error(e);
@@ -212,8 +198,10 @@ Result<JobStatus> Coordinator::submit_one(JobSettings settings, const std::strin
     return make_error(Code::Unprocessable, "webhook_not_allowed",
                       "webhook '" + settings.webhook + "' does not start with any --webhook-allow prefix");
   {
-    std::lock_guard<std::mutex> lock(s.mu);
-    if (Status st = s.check_active_jobs(); !st.ok()) return st;
+    // Checked before the scene is loaded, so a flood of submissions costs no unpacking, and again
+    // before the job is stored.
+    MutexLock lock(s.mu);
+    if (Status st = s.jobs.check_active(s.opt.max_active_jobs); !st.ok()) return st;
   }
   if (!bundle.empty()) {
     Result<SceneUpload> uploaded = upload_scene(bundle);
@@ -236,10 +224,10 @@ Result<JobStatus> Coordinator::submit_one(JobSettings settings, const std::strin
 
 Result<JobStatus> Coordinator::Impl::add_job(const std::string& name, JobPlan plan) {
   {
-    std::lock_guard<std::mutex> lock(mu);
+    MutexLock lock(mu);
     if (stopping) return make_error(Code::Unavailable, "stopping", "the coordinator is shutting down");
-    if (Status st = check_active_jobs(); !st.ok()) return st;
-    ++submissions_in_flight;
+    if (Status st = jobs.check_active(opt.max_active_jobs); !st.ok()) return st;
+    jobs.take_slot();
   }
   const double now = wall_seconds();
   const int priority = plan.settings.priority;
@@ -249,8 +237,8 @@ Result<JobStatus> Coordinator::Impl::add_job(const std::string& name, JobPlan pl
     id = store.add_job(name, to_json(plan).dump(), priority, now);
     job = std::make_unique<JobState>(id, std::move(plan), name, priority, now);
   } catch (const std::exception& e) {
-    std::lock_guard<std::mutex> lock(mu);
-    --submissions_in_flight;
+    MutexLock lock(mu);
+    jobs.give_back_slot();
     return internal_error(e);
   }
   log_event(spdlog::level::info, "job.submitted",
@@ -260,31 +248,31 @@ Result<JobStatus> Coordinator::Impl::add_job(const std::string& name, JobPlan pl
   JobStatus status;
   {
     // Stored, so accepted (even if the coordinator began stopping meanwhile: it runs after a restart).
-    std::lock_guard<std::mutex> lock(mu);
-    --submissions_in_flight;
-    status = status_of(*job);
-    save_decisions(*job);
-    jobs.emplace(id, std::move(job));
+    MutexLock lock(mu);
+    jobs.give_back_slot();
+    JobState& added = jobs.add(std::move(job));
+    status = status_of(added);
+    save_decisions(added);
     work_cv.notify_all();
   }
   add_lease_counts(status);
   return status;
 }
 
-JobStatus Coordinator::Impl::status_of(const JobState& job) const {
+JobStatus Coordinator::Impl::status_of(const JobState& job) {
   JobStatus s;
   const JobPlan& p = job.plan();
   s.id = job.id();
   s.name = job.name();
-  s.state = phase_name(job.phase);
+  s.state = phase_name(job.phase());
   s.priority = job.priority();
   s.error = job.error;
   if (p.settings.denoise) {
     // (A Done job's error is its denoise error: complete_job.)
-    s.denoise_state = job.phase == JobPhase::Done ? (job.error.empty() ? "done" : "failed")
+    s.denoise_state = job.phase() == JobPhase::Done ? (job.error.empty() ? "done" : "failed")
                       : job.denoise_pending       ? "running"
                                                   : "waiting";
-    if (job.phase == JobPhase::Done) std::swap(s.error, s.denoise_error);
+    if (job.phase() == JobPhase::Done) std::swap(s.error, s.denoise_error);
   }
   s.settings = p.settings;
   s.scene_file = p.scene_file;
@@ -303,8 +291,8 @@ JobStatus Coordinator::Impl::status_of(const JobState& job) const {
   s.eta_seconds = s.progress > 0 && s.progress < 1 ? s.elapsed_seconds * (1 - s.progress) / s.progress : 0.0;
   s.created = job.created();
   for (auto& [wid, samples] : job.samples_by_worker()) {
-    auto w = workers.find(wid);
-    s.workers.push_back({wid, w != workers.end() ? w->second.row.name : "", samples,
+    const WorkerInfo* w = workers.find(wid);
+    s.workers.push_back({wid, w ? w->row.name : "", samples,
                          s.samples_done ? double(samples) / double(s.samples_done) : 0});
   }
   s.duplicate_results = job.duplicates;
@@ -334,21 +322,21 @@ void Coordinator::Impl::add_lease_counts(JobStatus& status) {
 Result<JobStatus> Coordinator::job_status(uint64_t id) {
   JobStatus status;
   {
-    std::lock_guard<std::mutex> lock(impl_->mu);
-    auto it = impl_->jobs.find(id);
-    if (it == impl_->jobs.end()) return impl_->missing_job(id);
-    status = impl_->status_of(*it->second);
+    MutexLock lock(impl_->mu);
+    const JobState* job = impl_->jobs.find(id);
+    if (!job) return impl_->missing_job(id);
+    status = impl_->status_of(*job);
   }
   impl_->add_lease_counts(status);
   return status;
 }
 
 Result<std::vector<JobSummary>> Coordinator::list_jobs() {
-  std::lock_guard<std::mutex> lock(impl_->mu);
+  MutexLock lock(impl_->mu);
   std::vector<JobSummary> list;
-  for (auto& [id, job] : impl_->jobs) {
+  for (const auto& [id, job] : impl_->jobs.all()) {
     const JobPlan& p = job->plan();
-    list.push_back({id, job->name(), phase_name(job->phase), job->error, job->priority(),
+    list.push_back({id, job->name(), phase_name(job->phase()), job->error, job->priority(),
                     job->progress(),
                     p.window.width(), p.window.height(), p.settings.spp});
   }
@@ -357,26 +345,25 @@ Result<std::vector<JobSummary>> Coordinator::list_jobs() {
 
 Status Coordinator::cancel_job(uint64_t id) {
   Impl& s = *impl_;
-  std::unique_lock<std::mutex> lock(s.mu);
-  auto it = s.jobs.find(id);
-  if (it == s.jobs.end()) return unknown_job(id);
-  JobState& job = *it->second;
-  if (is_terminal(job.phase))
-    return make_error(Code::Conflict, "job_finished", "job " + std::to_string(id) + " is already " + phase_name(job.phase));
-  const uint64_t ticket = s.change_phase(job, JobPhase::Cancelled);
+  MutexLock lock(s.mu);
+  JobState* job = s.jobs.find(id);
+  if (!job) return unknown_job(id);
+  if (is_terminal(job->phase()))
+    return make_error(Code::Conflict, "job_finished", "job " + std::to_string(id) + " is already " + phase_name(job->phase()));
+  const uint64_t ticket = s.change_phase(*job, JobPhase::Cancelled);
   lock.unlock();
   return s.durable(ticket);
 }
 
 Status Coordinator::set_priority(uint64_t id, int priority) {
   Impl& s = *impl_;
-  std::unique_lock<std::mutex> lock(s.mu);
-  auto it = s.jobs.find(id);
-  if (it == s.jobs.end()) return unknown_job(id);
-  if (is_terminal(it->second->phase))
+  MutexLock lock(s.mu);
+  JobState* job = s.jobs.find(id);
+  if (!job) return unknown_job(id);
+  if (is_terminal(job->phase()))
     return make_error(Code::Conflict, "job_finished",
-                      "job " + std::to_string(id) + " is " + phase_name(it->second->phase) + "; retry it first");
-  it->second->set_priority(priority);
+                      "job " + std::to_string(id) + " is " + phase_name(job->phase()) + "; retry it first");
+  s.jobs.set_priority(*job, priority);
   const uint64_t ticket = s.commits.append([id, priority](Store& st) { st.set_job_priority(id, priority); },
                                            GroupCommit::Retry::UntilDurable);
   log_event(spdlog::level::info, "job.priority", {{"job", id}, {"priority", priority}});
@@ -393,13 +380,12 @@ Status Coordinator::retry_job(uint64_t id) {
   };
   JobRow row;
   {
-    std::lock_guard<std::mutex> lock(s.mu);
-    auto it = s.jobs.find(id);
-    if (it == s.jobs.end()) return unknown_job(id);
-    const JobState& old = *it->second;
-    if (old.phase != JobPhase::Failed && old.phase != JobPhase::Cancelled) return not_ended(old.phase);
-    row = JobRow{id, old.name(), to_json(old.plan()).dump(), phase_name(old.phase), old.error, old.priority(),
-                 old.created(), old.started, old.finished};
+    MutexLock lock(s.mu);
+    const JobState* old = s.jobs.find(id);
+    if (!old) return unknown_job(id);
+    if (old->phase() != JobPhase::Failed && old->phase() != JobPhase::Cancelled) return not_ended(old->phase());
+    row = JobRow{id, old->name(), to_json(old->plan()).dump(), phase_name(old->phase()), old->error, old->priority(),
+                 old->created(), old->started, old->finished};
   }
   // The passes it has stay: the job is rebuilt from its checkpoints and results (film included),
   // reading and decoding them off the lock.
@@ -409,14 +395,14 @@ Status Coordinator::retry_job(uint64_t id) {
   } catch (const std::exception& e) {
     return internal_error(e);
   }
-  std::unique_lock<std::mutex> lock(s.mu);
-  auto it = s.jobs.find(id);
-  if (it == s.jobs.end()) return unknown_job(id);
-  if (it->second->phase != JobPhase::Failed && it->second->phase != JobPhase::Cancelled)
-    return not_ended(it->second->phase);  // (retried by another request meanwhile)
-  s.save_decisions(*job);
-  const uint64_t ticket = s.change_phase(*job, JobPhase::Queued);
-  it->second = std::move(job);
+  MutexLock lock(s.mu);
+  const JobState* now = s.jobs.find(id);
+  if (!now) return unknown_job(id);
+  if (now->phase() != JobPhase::Failed && now->phase() != JobPhase::Cancelled)
+    return not_ended(now->phase());  // (retried by another request meanwhile)
+  JobState& fresh = s.jobs.replace(std::move(job));
+  s.save_decisions(fresh);
+  const uint64_t ticket = s.change_phase(fresh, JobPhase::Queued);
   lock.unlock();
   return s.durable(ticket);
 }

@@ -18,10 +18,6 @@
 
 namespace tessera::server {
 
-std::string Coordinator::Impl::denoised_path(uint64_t job) const {
-  return (std::filesystem::path(opt.data_dir) / "images" / (std::to_string(job) + ".denoised.exr")).string();
-}
-
 ImageAttributes Coordinator::Impl::image_attributes(const JobState& job) const {
   return {{"tessera_version", TESSERA_VERSION}, {"tessera_job", std::to_string(job.id())},
           {"tessera_spp", std::to_string(image_spp(job))}, {"tessera_seed", std::to_string(job.plan().settings.seed)}};
@@ -32,7 +28,7 @@ void Coordinator::Impl::complete_job(JobState& job) {
     (void)change_phase(job, JobPhase::Done);
     return;
   }
-  if (job.denoise_pending || is_terminal(job.phase)) return;
+  if (job.denoise_pending || is_terminal(job.phase())) return;
   job.denoise_pending = true;
   // Its sums durable first, as finish_job does: the images take a while.
   for (uint32_t t = 0; t < job.num_tiles(); ++t) checkpoint_tile(job, t, 1);
@@ -56,13 +52,13 @@ void Coordinator::Impl::complete_job(JobState& job) {
     } catch (const std::exception& e) {
       error = std::string(raw_written ? "denoising failed: " : "the raw image was not written: ") + e.what();
     }
-    std::lock_guard<std::mutex> lock(mu);
-    auto it = jobs.find(id);
-    if (it == jobs.end()) return;
-    JobState& j = *it->second;
+    MutexLock lock(mu);
+    JobState* found = jobs.find(id);
+    if (!found) return;
+    JobState& j = *found;
     j.denoise_pending = false;
     j.images_written = raw_written;
-    if (is_terminal(j.phase)) return finish_job(j, /*notify=*/true);  // (cancelled meanwhile)
+    if (is_terminal(j.phase())) return finish_job(j, /*notify=*/true);  // (cancelled meanwhile)
     j.error = error;  // (a Done job's error is its denoise error)
     if (error.empty()) log_event(spdlog::level::info, "job.denoised", {{"job", id}, {"seconds", seconds}});
     else log_event(spdlog::level::err, "job.denoise_failed", {{"job", id}, {"reason", error}});
@@ -71,7 +67,7 @@ void Coordinator::Impl::complete_job(JobState& job) {
 }
 
 void Coordinator::Impl::refresh_denoised_preview(JobState& job) {
-  if (job.preview_denoise_pending || job.denoise_pending || is_terminal(job.phase)) return;
+  if (job.preview_denoise_pending || job.denoise_pending || is_terminal(job.phase())) return;
   if (job.denoised_preview && job.denoised_preview_changes == job.film_changes()) return;
   job.preview_denoise_pending = true;
   denoising.push([this, id = job.id(), changes = job.film_changes()] {
@@ -87,12 +83,12 @@ void Coordinator::Impl::refresh_denoised_preview(JobState& job) {
     } catch (const std::exception& e) {
       spdlog::warn("job {}: preview not denoised: {}", id, e.what());
     }
-    std::lock_guard<std::mutex> lock(mu);
-    auto it = jobs.find(id);
-    if (it == jobs.end()) return;
-    JobState& j = *it->second;
+    MutexLock lock(mu);
+    JobState* found = jobs.find(id);
+    if (!found) return;
+    JobState& j = *found;
     j.preview_denoise_pending = false;
-    if (!preview || is_terminal(j.phase)) return;
+    if (!preview || is_terminal(j.phase())) return;
     j.denoised_preview = std::move(preview);
     j.denoised_preview_changes = changes;
   });

@@ -49,11 +49,11 @@ void log_change(const JobState& job, JobPhase to) {
 }  // namespace
 
 uint64_t Coordinator::Impl::change_phase(JobState& job, JobPhase to, const std::string& error) {
-  if (!allowed(job.phase, to))
+  if (!allowed(job.phase(), to))
     throw std::logic_error(std::string("job ") + std::to_string(job.id()) + ": no transition from " +
-                           phase_name(job.phase) + " to " + phase_name(to));
+                           phase_name(job.phase()) + " to " + phase_name(to));
   const double now = wall_seconds();
-  job.phase = to;
+  jobs.set_phase(job, to);
   if (to == JobPhase::Running) job.started = now;
   if (is_terminal(to)) job.finished = now;
   if (to == JobPhase::Failed) job.error = error;
@@ -62,7 +62,7 @@ uint64_t Coordinator::Impl::change_phase(JobState& job, JobPhase to, const std::
     job.error.clear();
   }
   const uint64_t ticket = append_phase(job);
-  if (is_terminal(to)) end_leases_if([&](const LeaseInfo& l) { return l.job == job.id(); });
+  if (is_terminal(to)) end_leases(leases.of_job(job.id()));
   log_change(job, to);
   work_cv.notify_all();
   if (is_terminal(to)) finish_job(job, /*notify=*/true);
@@ -71,9 +71,18 @@ uint64_t Coordinator::Impl::change_phase(JobState& job, JobPhase to, const std::
 
 uint64_t Coordinator::Impl::append_phase(const JobState& job) {
   return commits.append(
-      [id = job.id(), phase = std::string(phase_name(job.phase)), error = job.error, started = job.started,
+      [id = job.id(), phase = std::string(phase_name(job.phase())), error = job.error, started = job.started,
        finished = job.finished](Store& st) { st.set_job_state(id, phase, error, started, finished); },
       GroupCommit::Retry::UntilDurable);
+}
+
+void Coordinator::Impl::send_webhook(const JobState& job) {
+  if (job.plan().settings.webhook.empty()) return;
+  // The body is made on the sender's thread: the lease log's counts are store reads.
+  webhooks.send(job.id(), job.plan().settings.webhook, [this, status = status_of(job)]() mutable {
+    add_lease_counts(status);
+    return to_json(status).dump();
+  });
 }
 
 }  // namespace tessera::server

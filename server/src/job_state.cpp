@@ -71,10 +71,21 @@ void JobState::restore_records(uint32_t pass, uint32_t tile, std::string_view re
 
 std::optional<size_t> JobState::next_unit() const {
   if (seq_.stopped()) return std::nullopt;
+  auto leasable = [&](size_t u) { return !committing_[u] && active_leases_[u] == 0 && seq_.ready(u); };
+  for (auto it = returned_.begin(); it != returned_.end();) {
+    if (leasable(*it)) return *it;
+    it = is_done(*it) || committing_[*it] || active_leases_[*it] > 0 ? returned_.erase(it) : std::next(it);
+  }
   const size_t open_end = seq_.first_unit(uint32_t(seq_.open_passes()));
-  for (size_t u = first_open_; u < open_end; ++u)
-    if (!committing_[u] && active_leases_[u] == 0 && seq_.ready(u)) return u;
+  while (cursor_ < open_end && (is_done(cursor_) || committing_[cursor_] || active_leases_[cursor_] > 0)) ++cursor_;
+  for (size_t u = cursor_; u < open_end; ++u)  // (past units waiting for their tile's state)
+    if (leasable(u)) return u;
   return std::nullopt;
+}
+
+void JobState::lease_ended(size_t unit) {
+  if (active_leases_[unit] > 0) --active_leases_[unit];
+  if (active_leases_[unit] == 0 && !is_done(unit) && !committing_[unit] && unit < cursor_) returned_.insert(unit);
 }
 
 void JobState::start_commit(size_t unit) {
@@ -86,6 +97,7 @@ void JobState::commit_failed(size_t unit) {
   if (committing_[unit]) {
     committing_[unit] = 0;
     --tile_committing_[tile_of(unit)];
+    if (unit < cursor_) returned_.insert(unit);
   }
   digests_.erase(unit);
 }
@@ -95,7 +107,6 @@ void JobState::mark_done(size_t unit, uint64_t worker) {
   seq_.mark_done(unit);
   accepted_from_[unit] = worker;
   samples_by_worker_[worker] += unit_samples(unit);
-  while (first_open_ < num_units() && is_done(first_open_)) ++first_open_;
 }
 
 bool JobState::add_result(size_t unit, FilmTile&& tile, uint64_t worker, std::string_view training) {
@@ -113,7 +124,6 @@ bool JobState::add_result(size_t unit, FilmTile&& tile, uint64_t worker, std::st
   result.tile = std::move(tile);
   result.records = std::string(training);
   (void)seq_.add_result(unit, std::move(result));
-  while (first_open_ < num_units() && is_done(first_open_)) ++first_open_;
   return true;
 }
 

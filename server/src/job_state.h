@@ -17,6 +17,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -102,13 +103,13 @@ class JobState {
   void restore_records(uint32_t pass, uint32_t tile, std::string_view records);
 
   // Leasing.
-  /// The first unit, pass-major, that is ready, neither done nor being committed, and not leased.
+  /// A unit that is ready, neither done nor being committed, and not leased: one handed back
+  /// (its lease ended without a result), else the first such, pass-major. Amortised O(1): a cursor
+  /// passes units leased or done once, and units handed back are kept apart.
   std::optional<size_t> next_unit() const;
   void lease_started(size_t unit) { ++active_leases_[unit]; }
   unsigned active_leases(size_t unit) const { return active_leases_[unit]; }
-  void lease_ended(size_t unit) {
-    if (active_leases_[unit] > 0) --active_leases_[unit];
-  }
+  void lease_ended(size_t unit);
   bool is_done(size_t unit) const { return seq_.is_done(unit); }
   uint64_t accepted_from(size_t unit) const { return accepted_from_[unit]; }
   /// A result for the unit is being committed: it is not leased again meanwhile, and a second
@@ -172,9 +173,11 @@ class JobState {
   const RenderCounters& counters() const { return seq_.films().counters(); }
   const std::map<uint64_t, uint64_t>& samples_by_worker() const { return samples_by_worker_; }
 
-  void set_priority(int p) { priority_ = p; }
+  /// Its phase and priority change in its registry (job_registry.h), which orders jobs by them.
+  JobPhase phase() const { return phase_; }
+  /// Rebuilding, before the job enters its registry: the phase its row stores.
+  void restore_phase(JobPhase phase) { phase_ = phase; }
 
-  JobPhase phase = JobPhase::Queued;
   std::string error;
   double started = 0, finished = 0;
   // Failure bookkeeping: per worker, failures on this job; the reasons, for the job's error text.
@@ -199,10 +202,13 @@ class JobState {
  private:
   Checkpoint film_checkpoint(uint32_t tile) const;
 
+  friend class JobRegistry;
+
   uint64_t id_;
   JobPlan plan_;
   std::string name_;
   int priority_;
+  JobPhase phase_ = JobPhase::Queued;
   double created_;
   PassSequencer seq_;
   std::vector<uint8_t> committing_;              // per unit
@@ -211,7 +217,8 @@ class JobState {
   std::vector<uint32_t> folded_;                 // per tile: passes in its checkpoint
   std::vector<uint16_t> tile_committing_;        // per tile: results being committed
   std::map<size_t, Sha256Digest> digests_;       // see remember_digest
-  mutable size_t first_open_ = 0;                // units before it are done
+  mutable size_t cursor_ = 0;                    // units before it were leased or done (next_unit)
+  mutable std::set<size_t> returned_;            // units behind the cursor handed back
   std::map<uint64_t, uint64_t> samples_by_worker_;
 };
 

@@ -13,6 +13,7 @@
 #include <atomic>
 #include <ctime>
 #include <filesystem>
+#include <set>
 
 namespace tessera::server {
 
@@ -61,30 +62,40 @@ Status Coordinator::Impl::missing_job(uint64_t id) {
 }
 
 std::optional<std::vector<RetentionJob>> Coordinator::Impl::retention_snapshot() {
-  std::lock_guard<std::mutex> lock(mu);
-  // Images a full disk kept from being written: the job ended, its film is still in memory.
-  for (auto& [id, job] : jobs)
-    if (is_terminal(job->phase) && job->has_film()) finish_job(*job, /*notify=*/true);
   std::vector<uint64_t> unmeasured;
-  for (auto& [id, job] : jobs)
-    if (!is_terminal(job->phase) || !retention.finished_result_bytes.count(id)) unmeasured.push_back(id);
-  std::vector<RetentionJob> snapshot;
-  try {
+  std::set<uint64_t> ended;  // of those, the jobs that had ended (their stored bytes no longer change)
+  bool every_job = false;
+  {
+    MutexLock lock(mu);
+    // Images a full disk kept from being written: the job ended, its film is still in memory.
+    for (const auto& [id, job] : jobs.all())
+      if (is_terminal(job->phase()) && job->has_film()) finish_job(*job, /*notify=*/true);
+    for (const auto& [id, job] : jobs.all())
+      if (!is_terminal(job->phase()) || !retention.finished_result_bytes.count(id)) {
+        unmeasured.push_back(id);
+        if (is_terminal(job->phase())) ended.insert(id);
+      }
+    every_job = unmeasured.size() == jobs.size();
+  }
+  std::map<uint64_t, uint64_t> measured;
+  try {  // (store reads: off the lock)
     // Once (at start-up) every job is unmeasured: one grouped query instead of one per job.
-    auto sizes = unmeasured.size() == jobs.size() ? store.result_bytes() : store.result_bytes(unmeasured);
-    std::map<uint64_t, uint64_t> measured(sizes.begin(), sizes.end());
-    for (uint64_t id : unmeasured) {
-      if (is_terminal(jobs.at(id)->phase)) retention.finished_result_bytes[id] = measured[id];
-      else retention.finished_result_bytes.erase(id);  // (retried: measured again when it ends)
-    }
-    for (auto& [id, job] : jobs) {
-      const bool finished = is_terminal(job->phase);
-      snapshot.push_back({id, finished, job->finished > 0 ? job->finished : job->created(), job->plan().settings.scene,
-                          finished ? retention.finished_result_bytes[id] : measured[id]});
-    }
+    for (const auto& [id, bytes] : every_job ? store.result_bytes() : store.result_bytes(unmeasured)) measured[id] = bytes;
   } catch (const std::exception& e) {
     spdlog::warn("retention: cannot measure stored results: {}", e.what());
     return std::nullopt;
+  }
+  MutexLock lock(mu);
+  for (uint64_t id : unmeasured) {
+    if (ended.count(id)) retention.finished_result_bytes[id] = measured[id];
+    else retention.finished_result_bytes.erase(id);  // (retried: measured again when it ends)
+  }
+  std::vector<RetentionJob> snapshot;
+  for (const auto& [id, job] : jobs.all()) {
+    const bool finished = is_terminal(job->phase());
+    auto known = retention.finished_result_bytes.find(id);
+    snapshot.push_back({id, finished, job->finished > 0 ? job->finished : job->created(), job->plan().settings.scene,
+                        finished && known != retention.finished_result_bytes.end() ? known->second : measured[id]});
   }
   return snapshot;
 }
@@ -131,7 +142,7 @@ RetentionReport Coordinator::Impl::carry_out_retention(const RetentionPlan& plan
   std::vector<const RetentionJob*> forgotten;
   std::vector<std::string> moved;
   {
-    std::lock_guard<std::mutex> lock(mu);
+    MutexLock lock(mu);
     std::map<uint64_t, const RetentionJob*> by_id;
     for (const RetentionJob& j : snapshot) by_id[j.id] = &j;
     for (uint64_t id : plan.jobs)
@@ -152,7 +163,7 @@ RetentionReport Coordinator::Impl::carry_out_retention(const RetentionPlan& plan
   if (report.deleted_jobs > 0) collect_unused_guides(trash);
   std::error_code ec;
   for (const fs::path& p : trash) fs::remove_all(p, ec);
-  std::lock_guard<std::mutex> lock(mu);
+  MutexLock lock(mu);
   retention.deleted_jobs += report.deleted_jobs;
   retention.deleted_bundles += report.deleted_bundles;
   retention.freed_bytes += report.freed_bytes;
@@ -175,13 +186,12 @@ void Coordinator::Impl::collect_unused_guides(std::vector<fs::path>& trash) {
 }
 
 bool Coordinator::Impl::forget_expired_job(const RetentionJob& j) {
-  auto it = jobs.find(j.id);
+  const JobState* job = jobs.find(j.id);
   // Retried (queued again) since the snapshot: not finished any more.
-  if (it == jobs.end() || !is_terminal(it->second->phase) ||
-      (it->second->finished > 0 ? it->second->finished : it->second->created()) != j.ended)
+  if (!job || !is_terminal(job->phase()) || (job->finished > 0 ? job->finished : job->created()) != j.ended)
     return false;
-  end_leases_if([&](const LeaseInfo& l) { return l.job == j.id; });
-  jobs.erase(it);
+  end_leases(leases.of_job(j.id));
+  jobs.erase(j.id);
   retention.finished_result_bytes.erase(j.id);
   return true;
 }
@@ -212,7 +222,7 @@ std::vector<const RetentionJob*> Coordinator::Impl::delete_expired_rows(const st
 bool Coordinator::Impl::move_expired_bundle(const std::string& hash, const RetentionBundle& b, std::vector<fs::path>& trash) {
   static std::atomic<uint64_t> trash_counter{0};
   bool referenced = false;  // by a job submitted since the snapshot
-  for (auto& [id, job] : jobs) referenced |= job->plan().settings.scene == hash;
+  for (const auto& [id, job] : jobs.all()) referenced |= job->plan().settings.scene == hash;
   std::error_code ec;
   const fs::path file = bundle_path(hash);
   if (referenced || (fs::exists(file, ec) && to_wall(fs::last_write_time(file, ec)) > b.last_use)) return false;

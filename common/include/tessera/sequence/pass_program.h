@@ -77,7 +77,6 @@ struct PassProgram {
   /// > 0: the estimate a `may_stop` barrier stops at.
   double target_error = 0;
   AdaptiveSettings adaptive_settings;
-  bool operator==(const PassProgram&) const = default;
 };
 
 /// Checks a program's consistency (films, barriers before decisions, artifacts made before they

@@ -1,0 +1,213 @@
+// Results: an upload is checked against its unit, committed with the group commit (the tile's
+// checkpoint in its place when it can be), added to its job once durable, and answered; a copy of
+// a unit already in is a duplicate, compared with the accepted one. Failed leases count against
+// the worker and the job.
+#include "coordinator_impl.h"
+#include "event_log.h"
+
+#include "tessera/farm/tile_result.h"
+
+#include <spdlog/spdlog.h>
+
+namespace tessera::server {
+
+namespace {
+Status unknown_worker(uint64_t id) {
+  return make_error(Code::NotFound, "unknown_worker", "no worker " + std::to_string(id) + "; register again");
+}
+}  // namespace
+
+Status Coordinator::Impl::durable(uint64_t ticket) {
+  try {
+    commits.wait(ticket);
+    return Status::success();
+  } catch (const std::exception& e) {
+    return internal_error(e);
+  }
+}
+
+Result<size_t> Coordinator::Impl::check_result(uint64_t worker, const TileResult& result) {
+  WorkerInfo* w = workers.find(worker);
+  if (!w) return unknown_worker(worker);
+  saw_worker(worker, *w);
+  JobState* found = jobs.find(result.job_id);
+  if (!found) return unknown_job(result.job_id);
+  JobState& job = *found;
+  if (job.phase() == JobPhase::Cancelled || job.phase() == JobPhase::Failed)
+    return make_error(Code::Gone, "job_ended", "job " + std::to_string(job.id()) + " is " + phase_name(job.phase()));
+  if (result.tile >= job.num_tiles() || result.pass >= job.num_passes())
+    return make_error(Code::BadRequest, "bad_result", "tile or pass out of range for job " + std::to_string(job.id()));
+  const size_t unit = job.unit(result.tile, result.pass);
+  if (!(result.film.rect() == job.rect(unit)) || result.sample_begin != job.sample_begin(unit) ||
+      result.sample_end != job.sample_end(unit))
+    return make_error(Code::BadRequest, "bad_result", "the result's rectangle or samples do not match the unit");
+  // (A late copy of a done unit is answered as a duplicate, its sums compared with the accepted ones.)
+  if (job.is_done(unit)) return unit;
+  if (result.film.has_aovs() != job.plan().settings.denoise)
+    return make_error(Code::BadRequest, "bad_result",
+                      job.plan().settings.denoise ? "a result of a denoised job must carry the AOV sums (format version 4)"
+                                                  : "the result carries AOV sums the job did not ask for");
+  if (!job.result_fits(unit, result.film))
+    return make_error(Code::BadRequest, "bad_result",
+                      "the result's per-pixel sample counts are not those its adaptive pass gives the tile");
+  std::string error;
+  if (!job.check_training(unit, result.training, error)) return make_error(Code::BadRequest, "bad_result", error);
+  return unit;
+}
+
+void Coordinator::Impl::result_committed(bool durable, uint64_t job_id, size_t unit, uint64_t worker,
+                                         TileResult& result, size_t bytes) {
+  JobState* found = jobs.find(job_id);
+  if (!found) return;
+  JobState& job = *found;
+  if (!durable) {  // not acknowledged: the unit is open again
+    job.commit_failed(unit);
+    work_cv.notify_all();
+    return;
+  }
+  const uint64_t samples = job.unit_samples(unit);
+  if (!job.add_result(unit, std::move(result.film), worker, result.training)) return;  // (a retry rebuilt it meanwhile)
+  save_decisions(job);
+  checkpoint_tile(job, job.tile_of(unit), 1);
+  job.result_bytes += bytes;
+  ++metrics.counters.done;
+  metrics.counters.bytes_in += bytes;
+  if (WorkerInfo* w = workers.find(worker)) {
+    w->units_done += 1;
+    w->samples_done += samples;
+    w->render_seconds += result.seconds;
+  }
+  log_event(spdlog::level::debug, "lease.done",
+            {{"job", job.id()}, {"unit", unit}, {"worker", worker}, {"seconds", result.seconds}});
+  // (The phase is kept until durable; a crash before that finds the job complete at start-up.)
+  if (!is_terminal(job.phase()) && job.complete()) complete_job(job);
+}
+
+uint64_t Coordinator::Impl::commit_result(JobState& job, size_t unit, uint64_t worker,
+                                          const std::shared_ptr<TileResult>& result, std::string_view bytes) {
+  // The tile's next pass with all before it checkpointed: stored as the tile's new checkpoint (its
+  // own bytes never stored). Otherwise stored as it came, and folded in later.
+  std::shared_ptr<JobState::Checkpoint> cp;
+  if (auto with = job.checkpoint_with(unit, result->film)) cp = std::make_shared<JobState::Checkpoint>(std::move(*with));
+  job.start_commit(unit);
+  // Another copy is still being rendered (speculative, or re-issued from a worker thought dead):
+  // its result will be checked against this one.
+  if (job.active_leases(unit) > 0) job.remember_digest(unit, tile_digest(result->film));
+  return commits.append(
+      [id = job.id(), tile = result->tile, pass = result->pass, worker, cp, result, data = cp ? "" : std::string(bytes),
+       now = wall_seconds()](Store& st) {
+        (void)st.add_result(id, tile, pass, worker, data, now);
+        if (!result->training.empty()) st.save_training(id, tile, pass, result->training);
+        // (This pass's row is stored without its bytes and the earlier ones' were dropped: nothing
+        // for the checkpoint to drop, hence `from` = `passes`.)
+        if (cp) st.save_checkpoint(id, tile, cp->passes, cp->passes, encode_checkpoint(id, *cp));
+      },
+      GroupCommit::Retry::No,
+      [this, id = job.id(), unit, worker, result, cp, n = bytes.size()](bool durable) TESSERA_REQUIRES(mu) {
+        JobState* job = jobs.find(id);
+        if (durable && cp && job) job->checkpoint_stored(cp->tile, cp->passes);
+        result_committed(durable, id, unit, worker, *result, n);
+      });
+}
+
+void Coordinator::Impl::checkpoint_tile(JobState& job, uint32_t tile, uint32_t min_new) {
+  std::optional<JobState::Checkpoint> cp = job.take_checkpoint(tile, min_new);
+  if (!cp) return;
+  auto shared = std::make_shared<JobState::Checkpoint>(std::move(*cp));
+  (void)commits.append(
+      [id = job.id(), shared](Store& st) {
+        st.save_checkpoint(id, shared->tile, shared->from, shared->passes, encode_checkpoint(id, *shared));
+      },
+      GroupCommit::Retry::No,
+      [this, id = job.id(), tile = shared->tile, from = shared->from](bool durable) TESSERA_REQUIRES(mu) {
+        JobState* job = jobs.find(id);
+        if (!durable && job) job->checkpoint_failed(tile, from);
+      });
+}
+
+void Coordinator::Impl::check_duplicate(JobState& job, size_t unit, uint64_t worker, const FilmTile& film) {
+  ++job.duplicates;
+  ++metrics.counters.duplicates;
+  const Sha256Digest* first = job.digest(unit);
+  if (!first || *first == tile_digest(film)) return;
+  // Renders are deterministic: a different answer for the same unit means a broken worker.
+  ++job.mismatched;
+  ++metrics.counters.mismatched;
+  log_event(spdlog::level::err, "result.mismatch",
+            {{"job", job.id()}, {"tile", job.tile_of(unit)}, {"pass", job.pass_of(unit)}, {"worker", worker}});
+}
+
+Result<ResultAck> Coordinator::upload_result(uint64_t worker, uint64_t /*lease*/, std::string_view bytes, bool next) {
+  Impl& s = *impl_;
+  const auto t0 = Clock::now();
+  auto result = std::make_shared<TileResult>();
+  std::string error;
+  if (!decode_tile_result(bytes, *result, error, s.opt.limits.max_pixels))
+    return make_error(Code::BadRequest, "bad_result", error);
+  s.adopt_worker(worker);
+  // Decided here and appended to the group commit; its callback adds it to the job once durable.
+  ResultAck ack{/*accepted=*/true, /*duplicate=*/false, next, std::nullopt};
+  uint64_t ticket = 0;
+  std::optional<Impl::IssuedLease> issued;
+  {
+    MutexLock lock(s.mu);
+    Result<size_t> checked = s.check_result(worker, *result);
+    if (!checked.ok()) return checked.status;
+    const size_t unit = checked.value;
+    JobState& job = *s.jobs.find(result->job_id);
+    for (uint64_t id : s.leases.of_unit(job.id(), unit))
+      if (s.leases.find(id)->worker == worker) s.end_lease(id);
+    if (job.is_done(unit) && job.accepted_from(unit) == worker) {
+      // The same worker again: a retry of an upload whose answer was lost (the coordinator
+      // restarted, or the connection broke), not a second render. Answered as it was the first time.
+    } else if (job.is_done(unit) || job.is_committing(unit)) {
+      s.check_duplicate(job, unit, worker, result->film);
+      ack.accepted = false;
+      ack.duplicate = true;
+    } else {
+      ticket = s.commit_result(job, unit, worker, result, bytes);
+    }
+    if (next) issued = s.next_lease(worker);  // (logged after the result: one commit for both)
+  }
+  if (Status st = ticket ? s.durable(ticket) : Status::success(); !st.ok()) {
+    if (issued) {  // (its own batch may have committed: the worker will not get it, so it ends)
+      MutexLock lock(s.mu);
+      s.end_lease(issued->lease.id);
+    }
+    return st;
+  }
+  if (issued) {
+    if (Status st = s.durable(issued->ticket); !st.ok()) return st;
+    ack.next = std::move(issued->lease);
+  }
+  s.metrics.upload_seconds.observe(std::chrono::duration<double>(Clock::now() - t0).count());
+  return ack;
+}
+
+Status Coordinator::fail_lease(uint64_t worker, uint64_t lease, const std::string& error) {
+  Impl& s = *impl_;
+  const std::string reason = error.substr(0, 2000);
+  MutexLock lock(s.mu);
+  const LeaseInfo* l = s.leases.find(lease);
+  if (!l || l->worker != worker)
+    return make_error(Code::NotFound, "unknown_lease",
+                      "worker " + std::to_string(worker) + " holds no lease " + std::to_string(lease));
+  JobState* found = s.jobs.find(l->job);
+  s.end_lease(lease);
+  if (!found) return Status::success();
+  JobState& job = *found;
+  ++job.failures_by_worker[worker];
+  ++s.metrics.counters.failed;
+  job.last_failure = reason;
+  log_event(spdlog::level::warn, "lease.failed", {{"lease", lease}, {"job", job.id()}, {"worker", worker}, {"reason", reason}});
+  // The job fails when its work fails on several workers (or on every worker there is).
+  const size_t needed = std::max<size_t>(1, std::min<size_t>(size_t(s.opt.failed_workers_limit), s.workers.live()));
+  if (is_terminal(job.phase()) || job.failures_by_worker.size() < needed) return Status::success();
+  const uint64_t ticket = s.change_phase(job, JobPhase::Failed,
+                                         "failed on " + std::to_string(job.failures_by_worker.size()) +
+                                             " worker(s); last error: " + reason);
+  lock.unlock();
+  return s.durable(ticket);
+}
+
+}  // namespace tessera::server

@@ -1,0 +1,101 @@
+// A job from its stored state: its row, its decisions (adaptive counts, artifacts and the records
+// that feed the next), its checkpoints and its results, in that order, so that the film's sums are
+// what they were before a restart, bit for bit.
+#include "coordinator_impl.h"
+
+#include "tessera/farm/sample_counts.h"
+#include "tessera/farm/sha256.h"
+#include "tessera/farm/tile_result.h"
+
+namespace tessera::server {
+
+std::unique_ptr<JobState> Coordinator::Impl::job_from_row(const JobRow& row) const {
+  JobPlan plan;
+  std::string error;
+  if (!job_plan_from_json(nlohmann::json::parse(row.plan_json), plan, error))
+    throw std::runtime_error("job " + std::to_string(row.id) + " in the state database: " + error);
+  auto job = std::make_unique<JobState>(row.id, std::move(plan), row.name, row.priority, row.created);
+  JobPhase phase;
+  job->restore_phase(parse_phase(row.state, phase) ? phase : JobPhase::Failed);
+  job->error = row.error;
+  job->started = row.started;
+  job->finished = row.finished;
+  return job;
+}
+
+void Coordinator::Impl::restore_artifacts(JobState& job) {
+  std::vector<std::string> hashes = store.guides(job.id());
+  if (hashes.empty()) return;  // (not even its first artifact was stored: it is made again)
+  std::string bytes, error;
+  try {
+    bytes = read_file(guide_path(hashes.back()));
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  std::shared_ptr<const Artifact> latest;
+  if (sha256_hex(bytes) == hashes.back()) latest = job.sequencer().builder()->decode(bytes, error);
+  if (!latest)
+    throw std::runtime_error("job " + std::to_string(job.id()) + ": its stored guide " + hashes.back() +
+                             " is missing or corrupt " + error);
+  job.restore_artifacts(std::move(hashes), std::move(latest));
+  for (uint32_t pass : job.passes_feeding_next())
+    store.for_each_training(job.id(), pass,
+                            [&](uint32_t tile, std::string&& records) { job.restore_records(pass, tile, records); });
+}
+
+std::unique_ptr<JobState> Coordinator::Impl::rebuild_job(const JobRow& row) {
+  auto job = job_from_row(row);
+  const std::string where = "job " + std::to_string(row.id) + ": ";
+  job->begin_rebuild();
+  if (job->sequencer().builder()) restore_artifacts(*job);
+  // An adaptive job's decided passes first: its results are checked against them.
+  store.for_each_pass_plan(row.id, [&](uint32_t pass, std::string&& data) {
+    std::vector<uint32_t> counts;
+    std::string err;
+    if (!decode_sample_counts(data, size_t(job->plan().window.area()), counts, err) ||
+        !job->restore_pass_plan(pass, std::move(counts), err))
+      throw std::runtime_error(where + err);
+  });
+  // Each tile's checkpoint first, then the passes after it, in pass order: the film's sums as they were.
+  store.for_each_checkpoint(row.id, [&](CheckpointRow&& c) {
+    TileResult sums;
+    std::string err;
+    if (!decode_tile_result(c.data, sums, err)) throw std::runtime_error(where + "stored checkpoint is corrupt: " + err);
+    if (c.tile >= job->num_tiles() || c.passes == 0 || c.passes > job->num_passes() ||
+        !(sums.film.rect() == job->rect(job->unit(c.tile, 0))) || sums.film.has_aovs() != job->plan().settings.denoise ||
+        sums.sample_end != job->sample_end(job->unit(c.tile, c.passes - 1)))
+      throw std::runtime_error(where + "stored checkpoint of tile " + std::to_string(c.tile) + " does not fit the job");
+    job->restore_checkpoint(c.tile, c.passes, std::move(sums.film));
+  });
+  store.for_each_result(row.id, [&](ResultRow&& r) {
+    if (r.tile >= job->num_tiles() || r.pass >= job->num_passes()) return;
+    const size_t unit = job->unit(r.tile, r.pass);
+    if (!job->pass_decided(r.pass))
+      throw std::runtime_error(where + "a result of pass " + std::to_string(r.pass) + " without its stored sample counts");
+    if (r.data.empty() || r.pass < job->passes_in_film(r.tile))
+      return job->mark_done(unit, r.worker);  // (held by its tile's checkpoint)
+    TileResult result;
+    std::string err;
+    if (!decode_tile_result(r.data, result, err)) throw std::runtime_error(where + "stored result is corrupt: " + err);
+    if (result.film.has_aovs() != job->plan().settings.denoise)
+      throw std::runtime_error(where + "a stored result of pass " + std::to_string(r.pass) + " does not fit the job's AOVs");
+    (void)job->add_result(unit, std::move(result.film), r.worker);
+  });
+  job->end_rebuild();
+  return job;
+}
+
+std::string encode_checkpoint(uint64_t job, const JobState::Checkpoint& cp) {
+  TileResult sums;
+  sums.job_id = job;
+  sums.tile = cp.tile;
+  sums.pass = cp.passes - 1;
+  sums.sample_end = cp.sample_end;
+  sums.film = cp.sums;
+  // Uncompressed: a checkpoint is written for most results, by the group commit's one writer, and
+  // compressing (even zstd's fastest mode) took a third of that writer's time to save a fifth of
+  // the bytes (sums are noise in their low bits). One per tile is within the storage bound as is.
+  return encode_tile_result(sums, kUncompressed);
+}
+
+}  // namespace tessera::server
