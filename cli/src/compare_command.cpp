@@ -1,6 +1,7 @@
 // `tessera compare`: error of a render against a reference image (relMSE, with and without the worst
 // 0.1% of pixels, MSE, channel means; with the reference's per-pixel variance a z-score summary and
 // the relMSE the reference's own noise adds). Used by bench/ scripts and by people.
+#include "tessera/cli/command_line.h"
 #include "tessera/cli/commands.h"
 #include "tessera/cli/convergence.h"
 #include "tessera/image/image.h"
@@ -9,6 +10,7 @@
 
 #include <cstdio>
 #include <exception>
+#include <memory>
 
 namespace tessera::cli {
 
@@ -38,6 +40,15 @@ int run_compare(const CompareOptions& options) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 1;
   }
+}
+
+Command add_compare_command(CLI::App& app) {
+  auto o = std::make_shared<CompareOptions>();
+  CLI::App* c = app.add_subcommand("compare", "Error of an image against a reference (relMSE, means, z-scores)");
+  c->add_option("image", o->image, "Rendered image (.exr/.pfm/.hdr)")->required()->check(CLI::ExistingFile);
+  c->add_option("reference", o->reference, "Reference image")->required()->check(CLI::ExistingFile);
+  c->add_option("--variance", o->variance, "Per-pixel variance of the reference")->check(CLI::ExistingFile);
+  return {c, [o] { return run_compare(*o); }};
 }
 
 }  // namespace tessera::cli

@@ -1,5 +1,6 @@
 // `tessera denoise IN.exr -o OUT.exr`: the denoiser (denoise/denoiser.h) on an EXR written with
 // `--aovs all`. An EXR output keeps the input's AOV layers beside the denoised image.
+#include "tessera/cli/command_line.h"
 #include "tessera/cli/commands.h"
 #include "tessera/denoise/denoiser.h"
 #include "tessera/image/image.h"
@@ -8,6 +9,7 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <memory>
 
 namespace tessera::cli {
 
@@ -43,6 +45,20 @@ int run_denoise(const DenoiseOptions& options) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 1;
   }
+}
+
+Command add_denoise_command(CLI::App& app) {
+  auto o = std::make_shared<DenoiseOptions>();
+  CLI::App* d = app.add_subcommand("denoise", "Denoise an EXR rendered with --aovs all (docs/denoising.md)");
+  d->add_option("input", o->input, "EXR with the AOV layers albedo, normal, depth, variance, half_a, half_b")
+      ->required()->check(CLI::ExistingFile);
+  d->add_option("-o,--output", o->outputs, "Output image(s): .exr (with the input's AOV layers), .pfm or .png")
+      ->required();
+  d->add_option("--mode", o->mode, "full, or preview (faster, less thorough)")
+      ->check(CLI::IsMember({"full", "preview"}))->capture_default_str();
+  d->add_option("--threads", o->threads, "Threads (default: all cores; the result is the same)")
+      ->check(CLI::NonNegativeNumber);
+  return {d, [o] { return run_denoise(*o); }};
 }
 
 }  // namespace tessera::cli

@@ -1,18 +1,19 @@
-// `tessera submit`, `tessera jobs`, `tessera cancel`: the farm's client side. submit loads the
-// scene locally first, so only the files it references are bundled and a broken scene fails here.
-#include "tessera/cli/commands.h"
+// `tessera submit`: the farm's client side of a render. The scene is loaded here first, so only
+// the files it references are bundled and a broken scene fails before anything is sent.
+#include "farm_connection.h"
+
+#include "tessera/cli/command_line.h"
 #include "tessera/cli/progress.h"
 #include "tessera/farm/bundle.h"
 #include "tessera/farm/job_scene.h"
 #include "tessera/scene/error.h"
-#include "tessera/client/farm_api.h"
 
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <thread>
 
 namespace tessera::cli {
@@ -20,26 +21,7 @@ namespace tessera::cli {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-std::string default_server_url() {
-  const char* env = std::getenv("TESSERA_SERVER");
-  return env && *env ? env : "http://127.0.0.1:8420";
-}
-
 namespace {
-
-// The coordinator's client, with the client token from --token-file or $TESSERA_CLIENT_TOKEN;
-// false (the reason printed, prefixed by `who`) if the token file cannot be read.
-bool make_client(const std::string& server, const std::string& token_file, const std::string& ca_file,
-                 const char* who, client::FarmApi& out) {
-  try {
-    out = client::FarmApi(client::FarmClient(server.empty() ? default_server_url() : server,
-                                             resolve_token("", token_file, "TESSERA_CLIENT_TOKEN"), ca_file));
-    return true;
-  } catch (const std::exception& e) {
-    std::cerr << who << ": " << e.what() << "\n";
-    return false;
-  }
-}
 
 std::string extension_of(const std::string& path) {
   std::string ext = fs::path(path).extension().string();
@@ -134,27 +116,22 @@ int finish_job(const client::FarmApi& api, uint64_t id, const std::vector<std::s
   return download_outputs(api, id, outputs, final_status) ? 0 : 1;
 }
 
-}  // namespace
-
-int run_submit(const SubmitOptions& o) {
+bool check_outputs(const SubmitOptions& o) {
   for (const auto& out : o.outputs) {
-    std::string ext = extension_of(out);
+    const std::string ext = extension_of(out);
     if (ext != "exr" && ext != "png" && ext != "pfm") {
       std::cerr << "tessera submit: output '" << out << "': unknown format (use .exr, .pfm or .png)\n";
-      return 2;
+      return false;
     }
     if (!o.frames.empty() && out.find('#') == std::string::npos) {
       std::cerr << "tessera submit: with --frames, output '" << out << "' needs '#'s for the frame number\n";
-      return 2;
+      return false;
     }
   }
-  client::FarmApi api(client::FarmClient(""));
-  if (!make_client(o.server, o.token_file, o.ca_file, "tessera submit", api)) return 2;
-  std::string why;
-  if (!api.valid(&why)) {
-    std::cerr << "tessera submit: " << why << "\n";
-    return 2;
-  }
+  return true;
+}
+
+JobSettings job_settings(const SubmitOptions& o) {
   JobSettings settings;
   settings.name = o.name.empty() ? fs::path(o.scene).stem().string() : o.name;
   settings.spp = o.spp;
@@ -171,20 +148,52 @@ int run_submit(const SubmitOptions& o) {
   settings.denoise = o.denoise;
   if (!o.guiding.empty()) settings.guiding = o.guiding == "on";
   settings.webhook = o.webhook;
+  return settings;
+}
 
-  std::string bundle;
+// Loads the scene as the coordinator will and bundles the files it references; the bundle's bytes
+// (settings.scene_file set to its XML), or none with the error printed.
+std::optional<std::string> bundle_scene(const std::string& scene_file, JobSettings& settings) {
   try {
-    const fs::path scene = fs::absolute(o.scene);
+    const fs::path scene = fs::absolute(scene_file);
     LoadedJobScene loaded = load_job_scene(scene.parent_path().string(), scene.filename().string(), settings, /*confine=*/false);
     BundlePlan plan = plan_bundle(scene.string(), scene_files(loaded.desc, loaded.loaded));
     settings.scene_file = plan.files.front();
-    bundle = pack_bundle(plan.root_dir, plan.files);
+    std::string bundle = pack_bundle(plan.root_dir, plan.files);
     std::cerr << "bundled " << plan.files.size() << " files (" << bundle.size() / 1024 << " KiB) from " << plan.root_dir
               << "\n";
+    return bundle;
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
-    return 1;
+    return std::nullopt;
   }
+}
+
+// A frame range's jobs: their ids printed, then (waiting) each finished in turn; the exit code.
+int finish_frames(const client::FarmApi& api, const json& answer, const std::vector<std::string>& outputs,
+                  const SubmitOptions& o) {
+  for (const json& job : answer["jobs"]) std::cout << job.value("id", uint64_t(0)) << "\n";
+  std::cerr << answer["jobs"].size() << " frame jobs submitted to " << api.url() << "\n";
+  if (!o.wait && outputs.empty()) return 0;
+  int code = 0;
+  for (const json& job : answer["jobs"]) {
+    const int frame = std::stoi(job["settings"]["defines"].value("frame", "0"));
+    std::vector<std::string> outs;
+    for (const auto& out : outputs) outs.push_back(frame_path(out, frame));
+    code = std::max(code, finish_job(api, job.value("id", uint64_t(0)), outs, o.quiet));
+  }
+  return code;
+}
+
+}  // namespace
+
+int run_submit(const SubmitOptions& o) {
+  if (!check_outputs(o)) return 2;
+  client::FarmApi api(client::FarmClient(""));
+  if (!connect(o.connection, "tessera submit", api)) return 2;
+  JobSettings settings = job_settings(o);
+  const std::optional<std::string> bundle = bundle_scene(o.scene, settings);
+  if (!bundle) return 1;
   // --wait without -o: the image lands where `tessera render` would put it, SCENE_STEM.exr here.
   std::vector<std::string> outputs = o.outputs;
   if (o.wait && outputs.empty())
@@ -192,25 +201,13 @@ int run_submit(const SubmitOptions& o) {
   json body = to_json(settings);
   body.erase("scene");
   if (!o.frames.empty()) body["frames"] = o.frames;
-  client::HttpReply r = api.submit_job(body, bundle);
-  json j = r.json();
+  client::HttpReply r = api.submit_job(body, *bundle);
+  const json j = r.json();
   if (!r.ok() || !j.is_object()) {
     std::cerr << "tessera submit: the coordinator refused the job: " << r.describe() << "\n";
     return 1;
   }
-  if (!o.frames.empty()) {
-    for (const json& job : j["jobs"]) std::cout << job.value("id", uint64_t(0)) << "\n";
-    std::cerr << j["jobs"].size() << " frame jobs submitted to " << api.url() << "\n";
-    if (!o.wait && outputs.empty()) return 0;
-    int code = 0;
-    for (const json& job : j["jobs"]) {
-      const int frame = std::stoi(job["settings"]["defines"].value("frame", "0"));
-      std::vector<std::string> outs;
-      for (const auto& out : outputs) outs.push_back(frame_path(out, frame));
-      code = std::max(code, finish_job(api, job.value("id", uint64_t(0)), outs, o.quiet));
-    }
-    return code;
-  }
+  if (!o.frames.empty()) return finish_frames(api, j, outputs, o);
   const uint64_t id = j.value("id", uint64_t(0));
   std::cout << id << "\n";
   std::cerr << "job " << id << " submitted to " << api.url() << ": " << j.value("width", 0) << "x"
@@ -220,34 +217,39 @@ int run_submit(const SubmitOptions& o) {
   return finish_job(api, id, outputs, o.quiet);
 }
 
-int run_jobs(const JobsOptions& o) {
-  client::FarmApi api(client::FarmClient(""));
-  if (!make_client(o.server, o.token_file, o.ca_file, "tessera jobs", api)) return 2;
-  client::HttpReply r = api.jobs();
-  json j = r.json();
-  if (!r.ok() || !j.is_object()) {
-    std::cerr << "tessera jobs: " << r.describe() << "\n";
-    return 1;
-  }
-  std::printf("%6s  %-10s %6s %9s %11s %6s  %s\n", "ID", "STATE", "PRIO", "PROGRESS", "SIZE", "SPP", "NAME");
-  for (const json& job : j["jobs"])
-    std::printf("%6llu  %-10s %6d %8.1f%% %5dx%-5d %6d  %s\n", (unsigned long long)job.value("id", uint64_t(0)),
-                job.value("state", "").c_str(), job.value("priority", 0), 100.0 * job.value("progress", 0.0),
-                job.value("width", 0), job.value("height", 0),
-                job.value("stopped_at_target", false) ? job.value("spp_done", 0) : job.value("spp", 0), job.value("name", "").c_str());
-  return 0;
-}
-
-int run_cancel(const JobsOptions& o) {
-  client::FarmApi api(client::FarmClient(""));
-  if (!make_client(o.server, o.token_file, o.ca_file, "tessera cancel", api)) return 2;
-  client::HttpReply r = api.cancel_job(o.cancel_id);
-  if (!r.ok()) {
-    std::cerr << "tessera cancel: " << r.describe() << "\n";
-    return 1;
-  }
-  std::cerr << "job " << o.cancel_id << " cancelled\n";
-  return 0;
+Command add_submit_command(CLI::App& app) {
+  auto o = std::make_shared<SubmitOptions>();
+  auto defines = std::make_shared<std::vector<std::string>>();
+  CLI::App* s = app.add_subcommand("submit", "Send a scene to a render farm coordinator (docs/api.md)");
+  s->add_option("scene", o->scene, "Scene file; only the files it references are uploaded")->required()
+      ->check(CLI::ExistingFile);
+  add_connection_options(*s, o->connection);
+  s->add_option("-o,--output", o->outputs, "Wait, then download the image(s): .exr, .pfm or .png");
+  s->add_flag("--wait", o->wait, "Wait for the job to finish, with a progress bar");
+  s->add_option("--spp", o->spp, "Samples per pixel (default: the scene's)")->check(CLI::PositiveNumber);
+  s->add_option("--width", o->width, "Film width (default: the scene's)")->check(CLI::PositiveNumber);
+  s->add_option("--height", o->height, "Film height (default: the scene's)")->check(CLI::PositiveNumber);
+  s->add_option("--seed", o->seed, "Sampling seed");
+  s->add_option("--tile-size", o->tile_size, "Tile edge in pixels (does not change the image)")->check(CLI::Range(4, 1024));
+  s->add_option("--priority", o->priority, "Higher runs first");
+  s->add_option("--name", o->name, "Job name (default: the scene's file name)");
+  s->add_option("-D", *defines, "Override a scene <default>: -D name=value");
+  s->add_option("--integrator", o->integrator, "Override the integrator")->check(CLI::IsMember({"path", "volpath", "direct"}));
+  s->add_option("--light-selection", o->light_selection, "power or bvh")->check(CLI::IsMember({"power", "bvh"}));
+  s->add_option("--target-error", o->target_error, "Stop at this estimated relMSE (--spp is then the budget)")
+      ->check(CLI::Range(0.0, 1.0));
+  s->add_option("--guiding", o->guiding,
+                "Path guiding, as for render: the same image (default: on for a guided_path integrator, else off)")
+      ->check(CLI::IsMember({"on", "off"}));
+  s->add_flag("--denoise", o->denoise,
+              "Denoise the finished image on the coordinator (job field denoise): each -o FILE.ext gets the "
+              "denoised image and FILE.noisy.ext the raw one (its EXR with the AOV layers), as render --denoise");
+  s->add_option("--adaptive", o->adaptive, "Adaptive sampling, as for render: the same image (default off)")
+      ->check(CLI::IsMember({"on", "off"}))->capture_default_str();
+  s->add_option("--webhook", o->webhook, "URL the coordinator POSTs the job's status to when it ends");
+  s->add_option("--frames", o->frames, "Render frames A-B, one job each with -D frame=N; '#'s in -o become N");
+  s->add_flag("-q,--quiet", o->quiet, "No progress output");
+  return {s, [o, defines] { return parse_defines(*defines, o->defines, "tessera submit") ? run_submit(*o) : 2; }};
 }
 
 }  // namespace tessera::cli

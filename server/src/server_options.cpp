@@ -6,8 +6,9 @@
 
 namespace tessera::server {
 
-int parse_server_args(int argc, char** argv, ServerOptions& o) {
-  CLI::App app{"tessera-server: the Tessera render farm coordinator"};
+namespace {
+
+void add_service_options(CLI::App& app, ServerOptions& o) {
   CoordinatorOptions& c = o.coordinator;
   app.add_option("--listen", o.listen, "HOST:PORT to listen on (port 0: any free port)")->capture_default_str();
   app.add_option("--port-file", o.port_file, "write the port actually bound to this file");
@@ -32,7 +33,9 @@ int parse_server_args(int argc, char** argv, ServerOptions& o) {
                  "threads that denoise a finished job's image (jobs with denoise), one job at a time; 0: every core. "
                  "The image does not depend on it")
       ->check(CLI::Range(0, 256))->capture_default_str();
+}
 
+void add_security_options(CLI::App& app, ServerOptions& o) {
   auto* security = "Security";
   app.add_option("--client-token", o.client_token, "bearer token for clients (else $TESSERA_CLIENT_TOKEN)")->group(security);
   app.add_option("--client-token-file", o.client_token_file, "read the client token from this file")->group(security);
@@ -46,7 +49,12 @@ int parse_server_args(int argc, char** argv, ServerOptions& o) {
   app.add_option("--header-timeout", o.header_timeout,
                  "seconds a connection may take to send a request's headers (slow clients are cut off)")
       ->check(CLI::Range(0.5, 600.0))->capture_default_str()->group(security);
+  app.add_option("--webhook-allow", o.coordinator.webhook_allow,
+                 "URL prefix a job's webhook must start with (repeatable; default: any)")
+      ->group(security);
+}
 
+void add_limit_options(CLI::App& app, CoordinatorOptions& c) {
   auto* limits = "Limits";
   app.add_option("--max-upload", c.max_upload_bytes, "largest scene bundle accepted, bytes")->capture_default_str()->group(limits);
   app.add_option("--max-unpacked", c.bundle_limits.max_unpacked_bytes, "largest unpacked bundle, bytes")
@@ -65,10 +73,9 @@ int parse_server_args(int argc, char** argv, ServerOptions& o) {
       ->capture_default_str()->group(limits);
   app.add_option("--max-active-jobs", c.max_active_jobs, "most queued and running jobs; more are refused (429)")
       ->check(CLI::PositiveNumber)->capture_default_str()->group(limits);
+}
 
-  app.add_option("--webhook-allow", c.webhook_allow, "URL prefix a job's webhook must start with (repeatable; default: any)")
-      ->group(security);
-
+void add_retention_options(CLI::App& app, CoordinatorOptions& c) {
   auto* retention = "Retention";
   app.add_option("--retain-days", c.retain_days,
                  "delete finished jobs (results, image) this many days after they ended, and bundles unused as long; 0: keep")
@@ -76,7 +83,9 @@ int parse_server_args(int argc, char** argv, ServerOptions& o) {
   app.add_option("--retain-bytes", c.retain_bytes,
                  "above this many bytes of results, images and bundles, delete the oldest finished jobs first; 0: no limit")
       ->capture_default_str()->group(retention);
+}
 
+void add_logging_options(CLI::App& app, ServerOptions& o) {
   auto* logging = "Logging";
   app.add_option("--log-format", o.log_format, "text, or json: one JSON object per line")
       ->check(CLI::IsMember({"text", "json"}))->capture_default_str()->group(logging);
@@ -86,13 +95,24 @@ int parse_server_args(int argc, char** argv, ServerOptions& o) {
       ->group(logging);
   app.add_option("--log-level", o.log_level, "debug (every lease), info (every job), warn or error")
       ->check(CLI::IsMember({"debug", "info", "warn", "error"}))->capture_default_str()->group(logging);
+}
+
+}  // namespace
+
+int parse_server_args(int argc, char** argv, ServerOptions& o) {
+  CLI::App app{"tessera-server: the Tessera render farm coordinator"};
+  add_service_options(app, o);
+  add_security_options(app, o);
+  add_limit_options(app, o.coordinator);
+  add_retention_options(app, o.coordinator);
+  add_logging_options(app, o);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
   // Long polls may hold at most half the HTTP threads; the rest always serve clients.
-  c.max_waiting_polls = std::max(1, o.http_threads / 2);
+  o.coordinator.max_waiting_polls = std::max(1, o.http_threads / 2);
   return -1;
 }
 

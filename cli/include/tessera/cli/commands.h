@@ -43,11 +43,17 @@ struct CompareOptions {
   std::string image, reference, variance;  // variance: the reference's per-pixel variance (optional)
 };
 
+/// How a farm command reaches its coordinator.
+struct ConnectionOptions {
+  std::string server;      // else $TESSERA_SERVER, else http://127.0.0.1:8420
+  std::string token_file;  // else $TESSERA_CLIENT_TOKEN
+  std::string ca_file;     // verifies an https:// server (else the system's CAs)
+};
+
 /// `tessera submit`: the same rendering flags as render, sent to a coordinator.
 struct SubmitOptions {
-  std::string scene, server;
-  std::string token_file;            // else $TESSERA_CLIENT_TOKEN
-  std::string ca_file;               // verifies an https:// server (else the system's CAs)
+  std::string scene;
+  ConnectionOptions connection;
   std::vector<std::string> outputs;  // implies wait
   int spp = 0, width = 0, height = 0, tile_size = 32, priority = 0;
   uint32_t seed = 0;
@@ -63,9 +69,7 @@ struct SubmitOptions {
 };
 
 struct JobsOptions {
-  std::string server;
-  std::string token_file;  // else $TESSERA_CLIENT_TOKEN
-  std::string ca_file;
+  ConnectionOptions connection;
   uint64_t cancel_id = 0;  // run_cancel
 };
 
