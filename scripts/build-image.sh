@@ -3,21 +3,32 @@
 # with debootstrap instead of pulled from a registry: the only network this needs is the Debian
 # archive the machine's apt already uses, and the image installs from exactly that archive.
 #
-# usage: scripts/build-image.sh [--rebuild-base] [TAG]     (TAG default: $TESSERA_IMAGE or tessera:0.1.0)
+# usage: scripts/build-image.sh [--rebuild-base] [--programs DIR] [TAG]
+#        (TAG default: $TESSERA_IMAGE or tessera:0.1.0). --programs DIR: put the tessera,
+#        tessera-server and tessera-worker of DIR (a Release build on this Debian 12 host, e.g. build/cli
+#        etc. gathered by the caller) into the image instead of compiling them in its build stage.
 # Run as root. The base is built once and reused (localhost/debian:12, also tagged debian:12-slim
 # for the runtime stage); --rebuild-base makes it again, e.g. after the archive moved on.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 rebuild_base=0
+programs=""
 tag="${TESSERA_IMAGE:-tessera:0.1.0}"
-for a in "$@"; do
-  case "$a" in
+while [ $# -gt 0 ]; do
+  case "$1" in
     --rebuild-base) rebuild_base=1 ;;
-    -*) echo "usage: build-image.sh [--rebuild-base] [TAG]" >&2; exit 2 ;;
-    *) tag="$a" ;;
+    --programs) programs=${2:?--programs needs a folder}; shift ;;
+    -*) echo "usage: build-image.sh [--rebuild-base] [--programs DIR] [TAG]" >&2; exit 2 ;;
+    *) tag="$1" ;;
   esac
+  shift
 done
+if [ -n "$programs" ]; then
+  for p in tessera tessera-server tessera-worker; do
+    [ -x "$programs/$p" ] || { echo "build-image: --programs $programs has no $p" >&2; exit 1; }
+  done
+fi
 
 need() { command -v "$1" >/dev/null || { echo "build-image: $1 is missing (scripts/install-deps.sh installs it)" >&2; exit 1; }; }
 need podman
@@ -120,5 +131,10 @@ echo "build-image: building $tag from docker/Dockerfile"
 t0=$SECONDS
 # --pull=never: the bases are the local ones above, never a registry's. --format docker keeps the
 # HEALTHCHECK (the OCI format has none).
-podman build --pull=never --format docker -f docker/Dockerfile -t "$tag" .
+from=()
+if [ -n "$programs" ]; then
+  from=(--build-arg PROGRAMS=prebuilt --build-context "host-build=$(cd "$programs" && pwd)")
+  echo "build-image: the programs are $programs's (not compiled again)"
+fi
+podman build --pull=never --format docker "${from[@]}" -f docker/Dockerfile -t "$tag" .
 echo "build-image: $tag built in $((SECONDS - t0)) s"

@@ -35,8 +35,8 @@ ApiReply<T> decode(HttpReply http, Decode&& decode_body) {
 HttpReply FarmApi::upload_scene(const std::string& bundle, double timeout) const {
   return http_.post_bytes(kApi + "/scenes", bundle, "application/gzip", timeout);
 }
-HttpReply FarmApi::download_scene(const std::string& hash, double timeout) const {
-  return http_.get(kApi + "/scenes/" + hash, timeout);
+HttpReply FarmApi::download_scene(const std::string& hash, const std::string& file, double timeout) const {
+  return http_.get_to_file(kApi + "/scenes/" + hash, file, timeout);
 }
 HttpReply FarmApi::download_guide(const std::string& hash, double timeout) const {
   return http_.get(kApi + "/guides/" + hash, timeout);

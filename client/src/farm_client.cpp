@@ -2,6 +2,8 @@
 
 #include <httplib.h>
 
+#include <fstream>
+
 namespace tessera::client {
 
 using nlohmann::json;
@@ -97,6 +99,32 @@ bool FarmClient::valid(std::string* why) const {
 
 HttpReply FarmClient::get(const std::string& path, double timeout) const {
   return reply_of(make_client({host_, port_, tls_, token_, ca_file_}, timeout)->Get(path.c_str()));
+}
+
+HttpReply FarmClient::get_to_file(const std::string& path, const std::string& file, double timeout) const {
+  std::ofstream out;
+  int status = 0;
+  std::string error_body;
+  auto client = make_client({host_, port_, tls_, token_, ca_file_}, timeout);
+  httplib::Result r = client->Get(
+      path.c_str(),
+      [&](const httplib::Response& response) {
+        status = response.status;
+        if (status >= 200 && status < 300) out.open(file, std::ios::binary | std::ios::trunc);
+        return status < 200 || status >= 300 || bool(out);
+      },
+      [&](const char* data, size_t n) {
+        if (status < 200 || status >= 300) return error_body.append(data, n).size() < (size_t(1) << 20);
+        return bool(out.write(data, std::streamsize(n)));
+      });
+  HttpReply reply = reply_of(r);
+  reply.body = std::move(error_body);
+  out.close();
+  if (r && reply.ok() && !out) {
+    reply.status = 0;
+    reply.transport = "cannot write " + file;
+  }
+  return reply;
 }
 
 HttpReply FarmClient::del(const std::string& path, const json& body, double timeout) const {

@@ -65,7 +65,7 @@ std::string normalise_path(const std::string& raw, bool is_dir, std::string& out
 /// not: the tar reader stops at the tar end marker and never reaches the gzip trailer, so a CRC or
 /// length mismatch (a corrupted upload) would pass. `cap` bounds the work (anything hidden after
 /// the tar end marker). Returns what is wrong, or "".
-std::string verify_gzip(const std::string& bytes, uint64_t cap) {
+std::string verify_gzip(std::string_view bytes, uint64_t cap) {
   z_stream zs{};
   if (inflateInit2(&zs, 16 + MAX_WBITS) != Z_OK) return "zlib cannot start";
   std::vector<unsigned char> out(size_t(256) << 10);
@@ -140,7 +140,7 @@ uint64_t BundleLimits::unpacked_limit(uint64_t bundle_bytes) const {
 
 namespace detail {
 
-BundleResult walk_bundle(const std::string& bytes, const BundleLimits& limits, EntrySink* sink) {
+BundleResult walk_bundle(std::string_view bytes, const BundleLimits& limits, EntrySink* sink) {
   BundleResult r;
   if (bytes.empty()) {
     r.error = "empty bundle (0 bytes)";
@@ -308,7 +308,7 @@ BundleResult walk_bundle(const std::string& bytes, const BundleLimits& limits, E
 
 }  // namespace detail
 
-BundleResult inspect_bundle(const std::string& bytes, const BundleLimits& limits) {
+BundleResult inspect_bundle(std::string_view bytes, const BundleLimits& limits) {
   return detail::walk_bundle(bytes, limits, nullptr);
 }
 

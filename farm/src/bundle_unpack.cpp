@@ -79,7 +79,7 @@ std::string random_suffix() {
 
 }  // namespace
 
-BundleResult unpack_bundle(const std::string& bytes, const std::string& dest_dir, const BundleLimits& limits,
+BundleResult unpack_bundle(std::string_view bytes, const std::string& dest_dir, const BundleLimits& limits,
                            const std::optional<std::set<std::string>>& only) {
   BundleResult r;
   fs::path dest = fs::path(dest_dir).lexically_normal();

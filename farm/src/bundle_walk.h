@@ -5,6 +5,7 @@
 #include "tessera/farm/bundle.h"
 
 #include <string>
+#include <string_view>
 
 namespace tessera::detail {
 
@@ -20,6 +21,6 @@ class EntrySink {
 
 /// Reads every entry of `bytes`, validating names, types and sizes; passes file data to `sink`
 /// (may be null). The error names the entry; on error `sink` may have received part of the data.
-BundleResult walk_bundle(const std::string& bytes, const BundleLimits& limits, EntrySink* sink);
+BundleResult walk_bundle(std::string_view bytes, const BundleLimits& limits, EntrySink* sink);
 
 }  // namespace tessera::detail

@@ -62,6 +62,13 @@ struct Reader {
 
 }  // namespace
 
+uint64_t max_tile_result_bytes(const TileRect& rect, bool aovs, bool training) {
+  const uint64_t raw = kHeaderBytes + uint64_t(rect.area()) * (kPixelBytes + (aovs ? kAovBytes : 0)) + 16 +
+                       (training ? kMaxTrainingBytes : 0) + kMaxDigestBytes;
+  // Frames compressed apart (concatenated) cost a little more than one: a generous margin.
+  return ZSTD_compressBound(size_t(raw)) + raw / 64 + (uint64_t(64) << 10);
+}
+
 std::string encode_tile_result(const TileResult& r, int level) {
   const TileRect& rect = r.film.rect();
   const RenderCounters& c = r.film.counters;

@@ -5,6 +5,7 @@
 #include "event_log.h"
 #include "scene_planner.h"
 
+#include "tessera/farm/mapped_file.h"
 #include "tessera/farm/sha256.h"
 #include "tessera/image/image.h"
 #include "tessera/scene/error.h"
@@ -92,29 +93,29 @@ Result<std::string> Coordinator::scene_bundle_path(const std::string& hash) {
   return path;
 }
 
-Result<std::string> Coordinator::scene_bundle(const std::string& hash) {
-  Result<std::string> path = scene_bundle_path(hash);
-  if (!path.ok()) return path.status;
-  try {
-    std::string bytes = read_file(path.value);
-    impl_->metrics.counters.bytes_out += bytes.size();
-    return bytes;
-  } catch (const std::exception& e) {
-    return internal_error(e);
-  }
+namespace {
+
+Result<StoredFile> stored_file(const std::string& path, FarmCounters& counters) {
+  std::error_code ec;
+  const uintmax_t size = fs::file_size(path, ec);
+  if (ec) return internal_error(std::runtime_error("cannot read " + path + ": " + ec.message()));
+  counters.bytes_out += size;
+  return StoredFile{path, size};
 }
 
-Result<std::string> Coordinator::guide(const std::string& hash) {
+}  // namespace
+
+Result<StoredFile> Coordinator::scene_bundle_file(const std::string& hash) {
+  Result<std::string> path = scene_bundle_path(hash);
+  if (!path.ok()) return path.status;
+  return stored_file(path.value, impl_->metrics.counters);
+}
+
+Result<StoredFile> Coordinator::guide_file(const std::string& hash) {
   if (!is_sha256_hex(hash)) return make_error(Code::BadRequest, "bad_hash", "'" + hash + "' is not a SHA-256 hash");
-  const std::string path = impl_->guide_path(hash);
+  const std::string path = impl_->guide_path(hash);  // (immutable once written: no lock)
   if (!fs::exists(path)) return make_error(Code::NotFound, "unknown_guide", "no guide " + hash);
-  try {
-    std::string bytes = read_file(path);  // (immutable once written: no lock)
-    impl_->metrics.counters.bytes_out += bytes.size();
-    return bytes;
-  } catch (const std::exception& e) {
-    return internal_error(e);
-  }
+  return stored_file(path, impl_->metrics.counters);
 }
 
 Result<JobSubmission> Coordinator::submit_frames(const JobRequest& request, const std::string& bundle) {
@@ -169,7 +170,8 @@ Result<std::string> Coordinator::Impl::unpack_scene(const JobSettings& settings,
       for (const auto& e : fs::recursive_directory_iterator(dir))
         if (e.is_regular_file()) entries.push_back({e.path().lexically_relative(dir).generic_string(), e.file_size()});
     } else {
-      BundleResult unpacked = unpack_bundle(read_file(bundle_file), dir, opt.bundle_limits);
+      const MappedFile bundle(bundle_file);
+      BundleResult unpacked = unpack_bundle(bundle.bytes(), dir, opt.bundle_limits);
       throw_if_disk_full(unpacked.error, opt.data_dir);
       if (!unpacked.ok()) return make_error(Code::BadRequest, "bad_bundle", unpacked.error);
       entries = std::move(unpacked.files);

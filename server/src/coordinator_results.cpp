@@ -137,6 +137,27 @@ void Coordinator::Impl::check_duplicate(JobState& job, size_t unit, uint64_t wor
             {{"job", job.id()}, {"tile", job.tile_of(unit)}, {"pass", job.pass_of(unit)}, {"worker", worker}});
 }
 
+BodyLimit Coordinator::result_limit(uint64_t worker, uint64_t lease) {
+  Impl& s = *impl_;
+  {
+    MutexLock lock(s.mu);
+    const LeaseInfo* l = s.leases.find(lease);
+    const JobState* job = l && l->worker == worker ? s.jobs.find(l->job) : nullptr;
+    if (job) {
+      const TileRect& r = job->rect(l->unit);
+      const bool aovs = job->plan().settings.denoise, training = job->sequencer().pass(job->pass_of(l->unit)).feeds.has_value();
+      return {max_tile_result_bytes(r, aovs, training),
+              "a result of lease " + std::to_string(lease) + " (a " + std::to_string(r.width()) + "x" +
+                  std::to_string(r.height()) + " tile" + (aovs ? ", with AOV sums" : "") +
+                  (training ? ", with training records" : "") + ")"};
+    }
+  }
+  const int t = s.opt.limits.max_tile_size;
+  return {max_tile_result_bytes({0, 0, t, t}, true, true),
+          "a result of a lease this coordinator does not hold (as much as the largest unit: a " + std::to_string(t) +
+              "x" + std::to_string(t) + " tile with AOV sums and training records)"};
+}
+
 Result<ResultAck> Coordinator::upload_result(uint64_t worker, uint64_t /*lease*/, std::string_view bytes, bool next) {
   Impl& s = *impl_;
   const auto t0 = Clock::now();

@@ -8,6 +8,9 @@
 #include <httplib.h>
 #include <spdlog/spdlog.h>
 
+#include <optional>
+#include <regex>
+
 namespace tessera::server {
 
 using nlohmann::json;
@@ -42,25 +45,46 @@ std::string transport_error_detail(const httplib::Request& req, int status, uint
 
 // cpp-httplib 0.11 bounds a body by its Content-Length only: a chunked body would be read into
 // memory without limit. No client of the farm sends one, so it is refused before it is read.
-// Bundles (scenes, jobs) may be as large as --max-upload, a tile result as its largest tile; every
-// other body is a small JSON message, so a heartbeat of 50 MB is refused unread.
-constexpr uint64_t kMaxMessageBytes = uint64_t(1) << 20, kMaxResultBytes = uint64_t(64) << 20;
+// Each kind of body has its own limit, named in the 413: a bundle (scenes, jobs) --max-upload, a
+// result what its unit's sums can take (Coordinator::result_limit), any other body (a small JSON
+// message) 1 MiB, so that a heartbeat of 50 MB is refused unread.
+constexpr uint64_t kMaxMessageBytes = uint64_t(1) << 20;
 
-bool refused_large_message(const httplib::Request& req, httplib::Response& res) {
+// The worker id of a result upload's path (/api/v1/workers/ID/results), if it is one.
+std::optional<uint64_t> result_upload_worker(const std::string& path) {
+  static const std::regex pattern(R"(/api/v1/workers/(\d{1,19})/results)");
+  std::smatch m;
+  if (!std::regex_match(path, m, pattern)) return std::nullopt;
+  return std::stoull(m[1].str());
+}
+
+BodyLimit body_limit(const httplib::Request& req, Coordinator& c) {
+  if (std::optional<uint64_t> worker = result_upload_worker(req.path)) {
+    uint64_t lease = 0;
+    try {
+      lease = req.has_param("lease") ? std::stoull(req.get_param_value("lease")) : 0;
+    } catch (const std::exception&) {
+    }
+    return c.result_limit(*worker, lease);
+  }
+  return {kMaxMessageBytes, "a JSON message"};
+}
+
+bool refused_large_message(const httplib::Request& req, httplib::Response& res, Coordinator& c) {
   const bool bundle = req.path == "/api/v1/scenes" || req.path == "/api/v1/jobs";
   if (bundle || !req.has_header("Content-Length")) return false;
-  const bool result = req.path.size() > 8 && req.path.compare(req.path.size() - 8, 8, "/results") == 0;
-  const uint64_t limit = result ? kMaxResultBytes : kMaxMessageBytes;
   uint64_t length = 0;
   try {
     length = std::stoull(req.get_header_value("Content-Length"));
   } catch (const std::exception&) {
     return false;  // (httplib refuses a malformed length itself)
   }
-  if (length <= limit) return false;
+  if (length <= kMaxMessageBytes && !result_upload_worker(req.path)) return false;
+  const BodyLimit limit = body_limit(req, c);
+  if (length <= limit.bytes) return false;
   refuse_and_close(res, 413, "payload_too_large",
-                   "the body has " + std::to_string(length) + " bytes; " + (result ? "a tile result" : "this message") +
-                       " may have at most " + std::to_string(limit));
+                   "the body has " + std::to_string(length) + " bytes; " + limit.what + " may have at most " +
+                       std::to_string(limit.bytes));
   return true;
 }
 
@@ -100,15 +124,16 @@ void install_logger(httplib::Server& http, ConnectionGuard* guard, ResponseRecor
 
 // Runs before the body is read: a stranger's upload is refused without being received (the
 // connection is then closed). The answer is the same for a missing and a wrong token.
-void install_gatekeeper(httplib::Server& http, const AuthTokens& tokens, ConnectionGuard* guard) {
-  http.set_pre_routing_handler([tokens, guard](const httplib::Request& req, httplib::Response& res) {
+void install_gatekeeper(httplib::Server& http, Coordinator& c, const AuthTokens& tokens, ConnectionGuard* guard) {
+  http.set_pre_routing_handler([&c, tokens, guard](const httplib::Request& req, httplib::Response& res) {
     if (guard) guard->request_started(peer(req));
     if (!authorized(tokens, required_access(req.method, req.path), req.get_header_value("Authorization"))) {
       res.set_header("WWW-Authenticate", "Bearer");
       refuse_and_close(res, 401, "unauthorized", "a valid bearer token is required");
       return httplib::Server::HandlerResponse::Handled;
     }
-    if (refused_chunked_body(req, res) || refused_large_message(req, res)) return httplib::Server::HandlerResponse::Handled;
+    if (refused_chunked_body(req, res) || refused_large_message(req, res, c))
+      return httplib::Server::HandlerResponse::Handled;
     normalise_body_headers(const_cast<httplib::Request&>(req));
     return httplib::Server::HandlerResponse::Unhandled;
   });
@@ -141,7 +166,7 @@ std::vector<Route> install_routes(httplib::Server& http, Coordinator& c, uint64_
                                   const AuthTokens& tokens, ConnectionGuard* guard, ResponseRecorder* recorder) {
   http.set_payload_max_length(size_t(max_body_bytes(max_upload_bytes)));
   install_logger(http, guard, recorder);
-  install_gatekeeper(http, tokens, guard);
+  install_gatekeeper(http, c, tokens, guard);
   Router r(http);
   add_operation_routes(r, c);
   add_scene_routes(r, c);

@@ -64,8 +64,18 @@ trap 'exit 130' INT TERM HUP
 . docker/podman-env.sh
 
 # --- the image -----------------------------------------------------------------------------------
+# With the programs this host has just built and tested (stripped, as the build stage installs
+# them), not compiled a second time: the same Debian 12 compiler and flags make the same binaries
+# (docker/Dockerfile, PROGRAMS). TESSERA_CONTAINER_COMPILE=1 compiles them in the image instead.
 t0=$SECONDS
-bash scripts/build-image.sh "$image" >"$tmp/build.log" 2>&1 || fail "scripts/build-image.sh failed"
+programs=()
+if [ "${TESSERA_CONTAINER_COMPILE:-0}" != 1 ]; then
+  mkdir -p "$tmp/programs"
+  install -m 0755 -s "$build_dir/cli/tessera" "$build_dir/server/tessera-server" "$build_dir/worker/tessera-worker" \
+    "$tmp/programs/" || fail "cannot gather the programs of $build_dir"
+  programs=(--programs "$tmp/programs")
+fi
+bash scripts/build-image.sh "${programs[@]}" "$image" >"$tmp/build.log" 2>&1 || fail "scripts/build-image.sh failed"
 grep '^build-image:' "$tmp/build.log" | sed 's/^/container: /'
 echo "container: image ready in $((SECONDS - t0)) s"
 

@@ -135,7 +135,13 @@ def check_dockerfile(c, root, flags):
     froms = [i.args.split()[0] for i in df.instructions if i.op == "FROM"]
     c.check(len(froms) >= 2 and froms[0] == "debian:12" and froms[-1] == "debian:12-slim",
             "Dockerfile: build on debian:12, runtime on debian:12-slim", f"FROMs {froms}")
-    c.check(all(f.startswith("debian:12") for f in froms), "Dockerfile: every stage is Debian 12", str(froms))
+    # Besides the Debian stages: the programs of a Debian 12 host (PROGRAMS=prebuilt: scratch, only
+    # copied) and the stage that picks one or the other.
+    c.check(all(f.startswith("debian:12") or f in ("scratch", "${PROGRAMS}") for f in froms),
+            "Dockerfile: every stage that runs something is Debian 12", str(froms))
+    c.check(re.search(r"^ARG PROGRAMS=build$", open(path).read(), re.M) is not None and
+            re.search(r"^COPY --from=programs /out/ /usr/local/bin/$", open(path).read(), re.M) is not None,
+            "Dockerfile: the programs are compiled by default (PROGRAMS=build) and copied from the chosen stage")
     stages = df.stages()
     build_runs = " ".join(i.args for i in stages[0] if i.op == "RUN")
     final_runs = " ".join(i.args for i in stages[-1] if i.op == "RUN")

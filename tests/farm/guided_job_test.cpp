@@ -131,10 +131,13 @@ std::string render_guided_unit(Coordinator& c, const json& lease_json, const Sce
   lease.settings.seed = seed;
   SpatialTree guide;
   if (lease.guide) {
-    server::Result<std::string> bytes = c.guide(lease.guide->hash);
-    EXPECT_TRUE(bytes.ok()) << bytes.status.detail;
-    EXPECT_EQ(sha256_hex(bytes.value), lease.guide->hash);
-    EXPECT_TRUE(decode_guide(bytes.value, guide, error)) << error;
+    server::Result<server::StoredFile> file = c.guide_file(lease.guide->hash);
+    EXPECT_TRUE(file.ok()) << file.status.detail;
+    std::ifstream in(file.value.path, std::ios::binary);
+    const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    EXPECT_EQ(bytes.size(), file.value.size);
+    EXPECT_EQ(sha256_hex(bytes), lease.guide->hash);
+    EXPECT_TRUE(decode_guide(bytes, guide, error)) << error;
   }
   return encode_tile_result(render_lease(scene, lease, lease.guide ? &guide : nullptr));
 }

@@ -3,6 +3,7 @@
 #include "tessera/farm/bundle.h"
 #include "tessera/sequence/guide_artifact.h"
 #include "tessera/farm/job_scene.h"
+#include "tessera/farm/mapped_file.h"
 #include "tessera/farm/sha256.h"
 
 #include <spdlog/spdlog.h>
@@ -27,14 +28,21 @@ std::string SceneCache::bundle_file(const Lease& lease, const client::FarmApi& a
   const fs::path path = fs::path(dir_) / "bundles" / (hash + ".bundle");
   std::lock_guard<std::mutex> lock(download_mutex_);
   if (fs::exists(path)) return path.string();
-  client::HttpReply r = api.download_scene(hash);
-  if (!r.ok()) throw std::runtime_error("cannot download scene bundle " + hash + ": " + r.describe());
-  if (sha256_hex(r.body) != hash) throw std::runtime_error("scene bundle " + hash + " arrived corrupt (hash mismatch)");
+  // Straight to disk (a bundle may be gigabytes), checked there, then renamed into place.
   const fs::path tmp = path.string() + ".tmp" + std::to_string(std::random_device{}());
-  std::ofstream(tmp, std::ios::binary).write(r.body.data(), std::streamsize(r.body.size()));
+  client::HttpReply r = api.download_scene(hash, tmp.string());
+  std::error_code ec;
+  if (!r.ok()) {
+    fs::remove(tmp, ec);
+    throw std::runtime_error("cannot download scene bundle " + hash + ": " + r.describe());
+  }
+  if (sha256_file_hex(tmp.string()) != hash) {
+    fs::remove(tmp, ec);
+    throw std::runtime_error("scene bundle " + hash + " arrived corrupt (hash mismatch)");
+  }
   fs::rename(tmp, path);
   ++downloads_;
-  spdlog::info("downloaded scene bundle {} ({} bytes)", hash.substr(0, 12), r.body.size());
+  spdlog::info("downloaded scene bundle {} ({} bytes)", hash.substr(0, 12), fs::file_size(path, ec));
   return path.string();
 }
 
@@ -48,14 +56,12 @@ std::shared_ptr<const CachedScene> SceneCache::load(const Lease& lease, const cl
   {
     std::lock_guard<std::mutex> lock(download_mutex_);
     if (!fs::exists(dir)) {
-      std::ifstream in(bundle, std::ios::binary);
-      std::ostringstream ss;
-      ss << in.rdbuf();
+      const MappedFile bytes(bundle);
       // The coordinator checked the bundle's compression ratio against its own --max-ratio (which
       // its operator may have raised for a scene): refusing here what it accepted would fail the job.
       BundleLimits limits;
       limits.max_ratio = 0;
-      BundleResult r = unpack_bundle(ss.str(), dir.string(), limits,
+      BundleResult r = unpack_bundle(bytes.bytes(), dir.string(), limits,
                                      std::set<std::string>(lease.files.begin(), lease.files.end()));
       if (!r.ok()) throw std::runtime_error("scene bundle " + lease.settings.scene.substr(0, 12) + ": " + r.error);
     }

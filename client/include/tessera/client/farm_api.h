@@ -47,7 +47,8 @@ class FarmApi {
 
   // Scenes and jobs (the client token). Job bodies are the JSON of docs/api.md.
   HttpReply upload_scene(const std::string& bundle, double timeout = 600) const;
-  HttpReply download_scene(const std::string& hash, double timeout = 600) const;
+  /// The bundle written to `file` as it arrives.
+  HttpReply download_scene(const std::string& hash, const std::string& file, double timeout = 600) const;
   /// A guided job's guide (guide_artifact.h bytes).
   HttpReply download_guide(const std::string& hash, double timeout = 600) const;
   /// Settings naming an uploaded bundle, or with the bundle in the same request (non-empty `bundle`).

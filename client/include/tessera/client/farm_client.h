@@ -32,6 +32,9 @@ class FarmClient {
   bool valid(std::string* why = nullptr) const;
 
   HttpReply get(const std::string& path, double timeout_seconds = 30) const;
+  /// GET with a 2xx body written to `file` as it arrives (never held whole: a bundle may be
+  /// gigabytes); the reply's body is empty then, an error answer's kept (it is small).
+  HttpReply get_to_file(const std::string& path, const std::string& file, double timeout_seconds = 600) const;
   HttpReply del(const std::string& path, const nlohmann::json& body = nlohmann::json::object(),
                 double timeout_seconds = 30) const;
   HttpReply post_json(const std::string& path, const nlohmann::json& body, double timeout_seconds = 30) const;

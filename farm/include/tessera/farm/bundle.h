@@ -15,6 +15,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace tessera {
@@ -45,15 +46,16 @@ struct BundleResult {
   bool ok() const { return error.empty(); }
 };
 
-/// Lists and validates a bundle held in memory (format detected from content: gzip'd tar, plain
-/// tar or zip). Reads every entry, so truncated or corrupt archives are caught.
-[[nodiscard]] BundleResult inspect_bundle(const std::string& bytes, const BundleLimits& limits = {});
+/// Lists and validates a bundle's bytes (in memory, or a mapped file: mapped_file.h; format detected
+/// from content: gzip'd tar, plain tar or zip). Reads every entry, so truncated or corrupt archives
+/// are caught.
+[[nodiscard]] BundleResult inspect_bundle(std::string_view bytes, const BundleLimits& limits = {});
 
 /// Validates, then writes the bundle's files under `dest_dir` (created if needed). With `only`,
 /// writes only those relative paths (the files a scene references) and fails if one is missing.
 /// Writes into a temporary sibling directory and renames it into place, so a failure leaves no
 /// partial tree; if `dest_dir` already exists it is replaced.
-[[nodiscard]] BundleResult unpack_bundle(const std::string& bytes, const std::string& dest_dir,
+[[nodiscard]] BundleResult unpack_bundle(std::string_view bytes, const std::string& dest_dir,
                                          const BundleLimits& limits = {},
                                          const std::optional<std::set<std::string>>& only = std::nullopt);
 

@@ -44,6 +44,11 @@ inline constexpr size_t kTileResultDigestBytes = 16;
 /// more than the bytes it saves.
 inline constexpr int kUncompressed = -1000;
 
+/// The most bytes a result of a unit over `rect` can take as sent (compressed or not): its sums,
+/// the AOV sums with `aovs`, and training records with `training` (at most kMaxTrainingBytes). What
+/// the coordinator reads of an upload for that unit.
+uint64_t max_tile_result_bytes(const TileRect& rect, bool aovs, bool training);
+
 /// Encodes (and compresses) a result; `level` is zstd's compression level, or kUncompressed. Pixel
 /// sums are noise in their low bits: level 1 makes them as small as level 3 does (within 0.2%) in a
 /// third of the time.

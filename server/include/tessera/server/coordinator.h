@@ -71,6 +71,18 @@ struct ImageBytes {
   std::string bytes, content_type;
 };
 
+/// A stored file to send as it is: streamed from disk, never read whole into memory.
+struct StoredFile {
+  std::string path;
+  uint64_t size = 0;
+};
+
+/// What an upload may weigh, and what it is (named in a 413's message).
+struct BodyLimit {
+  uint64_t bytes = 0;
+  std::string what;
+};
+
 class Coordinator {
  public:
   /// Opens the data directory and resumes every unfinished job. Throws std::runtime_error with the
@@ -84,10 +96,11 @@ class Coordinator {
   Result<SceneUpload> upload_scene(const std::string& bundle);
   /// Path of the stored bundle file.
   Result<std::string> scene_bundle_path(const std::string& hash);
-  /// The stored bundle's bytes (what workers download).
-  Result<std::string> scene_bundle(const std::string& hash);
-  /// A guided job's stored guide (guide_artifact.h bytes) by its SHA-256.
-  Result<std::string> guide(const std::string& hash);
+  /// The stored bundle (what workers download).
+  Result<StoredFile> scene_bundle_file(const std::string& hash);
+  /// An artifact a job renders with (a guided job's guide, sequence/guide_artifact.h bytes) by its
+  /// SHA-256.
+  Result<StoredFile> guide_file(const std::string& hash);
 
   // Jobs. `bundle` non-empty: uploaded in the same request (the settings' scene may be empty).
   // With "frames": "A-B" (or [A, B]) in the settings, one job per frame N in A..B, each with
@@ -114,6 +127,10 @@ class Coordinator {
   /// answer lists those the coordinator no longer wants (to drop). The memory it reports is shown
   /// in its status until the next heartbeat.
   Result<std::vector<uint64_t>> heartbeat(uint64_t worker, const Heartbeat& heartbeat);
+  /// The largest result `worker` may upload for `lease`: what its unit's sums can take (tile area,
+  /// AOV sums, training records); for a lease this coordinator does not know (a restart), the
+  /// largest any unit within its limits can take.
+  BodyLimit result_limit(uint64_t worker, uint64_t lease);
   /// A tile result (tile_result.h bytes). Accepted once per unit: a duplicate is acknowledged and
   /// dropped. Valid without a live lease too (a worker finishing across a coordinator restart).
   /// Answered once durable. With `next`, the answer also carries the worker's next lease (none
