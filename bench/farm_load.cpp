@@ -42,6 +42,7 @@ struct Options {
   int workers = 64, http_threads = 64, tile_size = 32, loop_threads = 2;
   double seconds = 20, poll_wait = 2, max_poll_wait = 30, tile_seconds = 2;
   uint64_t units = 20000;
+  int queued_jobs = 0;  // more jobs, of a lower priority, queued behind the measured one
 };
 
 // The smallest scene the loader takes: the coordinator loads it once at submission.
@@ -125,10 +126,10 @@ struct Figures {
 };
 
 void report(const Options& o, const JobShape& shape, const Figures& f) {
-  std::printf("farm load: %d simulated workers, %d HTTP threads, job of %dx%d tiles of %d px x %d passes = %llu units; "
-              "%u cores shared by the coordinator and the load generator\n",
+  std::printf("farm load: %d simulated workers, %d HTTP threads, job of %dx%d tiles of %d px x %d passes = %llu units "
+              "(%d more jobs queued behind it); %u cores shared by the coordinator and the load generator\n",
               o.workers, o.http_threads, shape.tiles_x, shape.tiles_y, o.tile_size, shape.passes,
-              (unsigned long long)f.units_total, std::thread::hardware_concurrency());
+              (unsigned long long)f.units_total, o.queued_jobs, std::thread::hardware_concurrency());
   char fed_header[32];
   std::snprintf(fed_header, sizeof(fed_header), "fed@%gs", o.tile_seconds);
   std::printf("%7s %5s %7s %7s %8s %9s %9s %10s %10s %8s %7s %8s %10s %7s %7s\n", "workers", "http", "units", "wall_s",
@@ -156,17 +157,42 @@ void report(const Options& o, const JobShape& shape, const Figures& f) {
   std::ofstream out(o.csv, std::ios::app);
   if (header)
     out << "workers,http_threads,units,wall_s,units_per_s,lease_p50_ms,lease_p99_ms,upload_p50_ms,upload_p99_ms,"
-           "coord_cpu_s,coord_cpu_pct,cpu_ms_per_unit,fsync_per_unit,bench_cpu_pct,workers_fed\n";
+           "coord_cpu_s,coord_cpu_pct,cpu_ms_per_unit,fsync_per_unit,bench_cpu_pct,workers_fed,queued_jobs\n";
   char row[512];
-  std::snprintf(row, sizeof(row), "%d,%d,%llu,%.2f,%.1f,%.2f,%.2f,%.2f,%.2f,%.2f,%.1f,%.3f,%.3f,%.1f,%.0f\n", o.workers,
+  std::snprintf(row, sizeof(row), "%d,%d,%llu,%.2f,%.1f,%.2f,%.2f,%.2f,%.2f,%.2f,%.1f,%.3f,%.3f,%.1f,%.0f,%d\n", o.workers,
                 o.http_threads, (unsigned long long)f.units, f.wall, f.units_per_second(), f.lease_p50, f.lease_p99,
                 f.upload_p50, f.upload_p99, f.coordinator_cpu, 100 * f.coordinator_cpu / f.wall, f.cpu_ms_per_unit(),
-                f.fsyncs_per_unit(), 100 * f.bench_cpu / f.wall, fed);
+                f.fsyncs_per_unit(), 100 * f.bench_cpu / f.wall, fed, o.queued_jobs);
   out << row;
 }
 
+// The jobs' counts summed: the measured job's, and those of the queued jobs its tail reached.
+struct JobCounts {
+  uint64_t done = 0, leases = 0, duplicates = 0;
+  std::vector<std::string> failures;
+};
+JobCounts job_counts(const client::FarmApi& api, const std::vector<uint64_t>& jobs) {
+  JobCounts c;
+  for (uint64_t job : jobs) {
+    json status = api.job(job, 10).json();
+    if (!status.is_object()) {
+      c.failures.push_back("no status for job " + std::to_string(job));
+      continue;
+    }
+    const uint64_t done = status.value("units_done", uint64_t(0)), total = status.value("units_total", uint64_t(0));
+    c.done += done;
+    c.leases += status.value("leases_issued", uint64_t(0));
+    c.duplicates += status.value("duplicate_results", uint64_t(0));
+    const std::string state = status.value("state", "");
+    if ((done == total) != (state == "done"))
+      c.failures.push_back("job " + std::to_string(job) + " state '" + state + "' with " + std::to_string(done) + "/" +
+                           std::to_string(total) + " units");
+  }
+  return c;
+}
+
 // Everything that must hold after a run, whatever its speed; the failures, empty if none.
-std::vector<std::string> check_run(ServerProcess& server, uint64_t job, const std::vector<SimStats>& stats) {
+std::vector<std::string> check_run(ServerProcess& server, const std::vector<uint64_t>& jobs, const std::vector<SimStats>& stats) {
   std::vector<std::string> failures;
   uint64_t leased = 0, accepted = 0, duplicates = 0;
   for (size_t i = 0; i < stats.size(); ++i) {
@@ -186,21 +212,13 @@ std::vector<std::string> check_run(ServerProcess& server, uint64_t job, const st
     return failures;
   }
   client::FarmApi api(client::FarmClient(server.url()));
-  json status = api.job(job, 10).json();
-  if (!status.is_object()) {
-    failures.push_back("no status for job " + std::to_string(job));
-  } else {
-    const uint64_t done = status.value("units_done", uint64_t(0)), total = status.value("units_total", uint64_t(0));
-    if (done != accepted)
-      failures.push_back("the job counts " + std::to_string(done) + " units done, the workers " + std::to_string(accepted));
-    if (status.value("leases_issued", uint64_t(0)) != leased)
-      failures.push_back("the job issued " + status.value("leases_issued", json()).dump() + " leases, the workers took " +
-                         std::to_string(leased));
-    if (status.value("duplicate_results", uint64_t(0)) != 0) failures.push_back("the job counts duplicate results");
-    const std::string state = status.value("state", "");
-    if ((done == total) != (state == "done"))
-      failures.push_back("job state '" + state + "' with " + std::to_string(done) + "/" + std::to_string(total) + " units");
-  }
+  JobCounts c = job_counts(api, jobs);
+  failures.insert(failures.end(), c.failures.begin(), c.failures.end());
+  if (c.done != accepted)
+    failures.push_back("the jobs count " + std::to_string(c.done) + " units done, the workers " + std::to_string(accepted));
+  if (c.leases != leased)
+    failures.push_back("the jobs issued " + std::to_string(c.leases) + " leases, the workers took " + std::to_string(leased));
+  if (c.duplicates != 0) failures.push_back("the jobs count duplicate results");
   client::HttpReply health = api.health(10);
   if (health.status != 200 || health.json().value("status", "") != "ok")
     failures.push_back("/healthz at the end: " + health.describe() + " " + health.body);
@@ -221,6 +239,16 @@ int run(const Options& o) {
   if (submitted.status != 201) throw std::runtime_error("job submission: " + submitted.describe());
   const uint64_t job = submitted.json().value("id", uint64_t(0));
   const uint64_t units_total = submitted.json().value("units_total", uint64_t(0));
+  // Queued behind it: one-unit jobs of the same bundle (by hash) at a lower priority, which the
+  // scheduler must not have to look through to find the measured job's next unit.
+  std::vector<uint64_t> jobs = {job};
+  for (int q = 0; q < o.queued_jobs; ++q) {
+    const json queued = {{"name", "queued"}, {"scene", submitted.json()["settings"]["scene"]}, {"spp", 1},
+                         {"width", o.tile_size}, {"height", o.tile_size}, {"tile_size", o.tile_size}, {"priority", -1}};
+    client::HttpReply r = api.submit_job(queued);
+    if (r.status != 201) throw std::runtime_error("queued job submission: " + r.describe());
+    jobs.push_back(r.json().value("id", uint64_t(0)));
+  }
 
   (void)build_fingerprint();  // its probe render once, before the threads ask for it
   SimShared shared;
@@ -269,7 +297,7 @@ int run(const Options& o) {
   f.lease_p99 = percentile(lease_ms, 0.99);
   f.upload_p50 = percentile(upload_ms, 0.5);
   f.upload_p99 = percentile(upload_ms, 0.99);
-  std::vector<std::string> failures = check_run(server, job, stats);
+  std::vector<std::string> failures = check_run(server, jobs, stats);
   if (server.alive()) {
     json status = api.job(job, 10).json();
     if (status.is_object() && status.value("units_done", uint64_t(0)) > 0)
@@ -308,6 +336,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--tile-seconds", o.tile_seconds, "render time per unit of a real worker, for the 'fed' figure")
       ->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--queued-jobs", o.queued_jobs, "jobs queued behind the measured one (lower priority, one unit each)")
+      ->check(CLI::Range(0, 100000))->capture_default_str();
   app.add_option("--csv", o.csv, "append the figures as a CSV row to this file");
   app.add_option("--server-flag", o.server_flags, "another flag for tessera-server (repeatable), e.g. "
                  "--server-flag=--commit-interval=0")->allow_extra_args(false);

@@ -9,6 +9,7 @@
 #include "raw_http.h"
 #include "tessera/farm/build_fingerprint.h"
 #include "tessera/farm/sha256.h"
+#include "tessera/farm/tile_result.h"
 
 #include <atomic>
 #include <csignal>
@@ -301,6 +302,48 @@ TEST(FarmAttack, HttpEdgeCasesAreAnsweredProperly) {
     EXPECT_NE(junk_body.body.find("at most 1048576"), std::string::npos) << junk_body.body;
   }
   EXPECT_TRUE(http.get("/healthz", 5).ok());
+}
+
+// Each kind of body has its own limit, named in the 413: a result may weigh what its unit's sums
+// can (a 16x16 tile here: tens of kilobytes, not the 64 MiB the largest tile would need), and a
+// result for a lease the coordinator does not hold what the largest unit's can.
+TEST(FarmAttack, AResultOverWhatItsUnitCanWeighIsRefusedUnread) {
+  TESSERA_REQUIRE_FILE(cornell());
+  Farm farm({"--client-token", kClient, "--worker-token", kWorker});
+  farm.set_tokens(kClient, kWorker);
+  farm.start_server();
+  const int port = farm.port();
+  JobSettings s;
+  s.spp = 4;
+  s.width = 32;
+  s.height = 32;
+  s.tile_size = 16;
+  ASSERT_GT(farm.submit(cornell(), s), 0u);
+  const client::FarmClient worker(farm.url(), kWorker);
+  const BuildFingerprint& fp = build_fingerprint();
+  const client::HttpReply reg =
+      worker.post_json("/api/v1/workers", json{{"name", "w"}, {"version", fp.version}, {"isa", fp.isa}, {"probe", fp.probe}});
+  ASSERT_EQ(reg.status, 201) << reg.body;
+  const std::string w = "/api/v1/workers/" + std::to_string(reg.json()["id"].get<uint64_t>());
+  const client::HttpReply lease = worker.post_bytes(w + "/lease?wait=5", "", "application/json");
+  ASSERT_EQ(lease.status, 200) << lease.body;
+  const uint64_t id = lease.json()["id"].get<uint64_t>();
+  const uint64_t limit = max_tile_result_bytes({0, 0, 16, 16}, false, false);
+  ASSERT_LT(limit, uint64_t(1) << 20);
+  const std::string auth = "Authorization: Bearer " + std::string(kWorker) + "\r\n";
+  const std::string over = raw_reply(port, curl_like("POST", w + "/results?lease=" + std::to_string(id),
+                                                     auth + "Content-Length: " + std::to_string(2u << 20) + "\r\n"), 5);
+  EXPECT_EQ(status_of(over), 413) << over;
+  EXPECT_NE(over.find("a result of lease " + std::to_string(id) + " (a 16x16 tile) may have at most " +
+                      std::to_string(limit)), std::string::npos) << over;
+  const std::string unknown = raw_reply(port, curl_like("POST", w + "/results?lease=999999",
+                                                        auth + "Content-Length: 900000000\r\n"), 5);
+  EXPECT_EQ(status_of(unknown), 413) << unknown;
+  EXPECT_NE(unknown.find("a lease this coordinator does not hold (as much as the largest unit: a 1024x1024 tile with AOV "
+                         "sums and training records) may have at most " +
+                         std::to_string(max_tile_result_bytes({0, 0, 1024, 1024}, true, true))),
+            std::string::npos) << unknown;
+  EXPECT_TRUE(farm.client().get("/healthz", 5).ok());
 }
 
 }  // namespace
