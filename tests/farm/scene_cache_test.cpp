@@ -2,11 +2,17 @@
 // used evicted beyond the memory budget, failures not cached.
 #include "tessera/farm/bundle.h"
 #include "tessera/farm/sha256.h"
+#include "tessera/sequence/guide_artifact.h"
 #include "tessera/scene/error.h"
 #include "tessera/worker/scene_cache.h"
 #include "test_support.h"
 
+#include <httplib.h>
+
+#include <atomic>
 #include <fstream>
+#include <map>
+#include <thread>
 
 namespace tessera::test {
 namespace {
@@ -79,6 +85,83 @@ TEST(SceneCache, FailuresAreReportedAndNotCached) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("cannot download"), std::string::npos) << e.what();
   }
+}
+
+// A coordinator that serves artifacts (GET /api/v1/guides/HASH) and counts the requests.
+struct ArtifactServer {
+  httplib::Server http;
+  std::map<std::string, std::string> by_hash;
+  std::atomic<int> requests{0};
+  std::thread thread;
+  int port = 0;
+  ArtifactServer() {
+    http.Get(R"(/api/v1/guides/([0-9a-f]{64}))", [this](const httplib::Request& req, httplib::Response& res) {
+      ++requests;
+      auto it = by_hash.find(req.matches[1].str());
+      if (it == by_hash.end()) {
+        res.status = 404;
+        return;
+      }
+      res.set_content(it->second, "application/octet-stream");
+    });
+    port = http.bind_to_any_port("127.0.0.1");
+    thread = std::thread([this] { http.listen_after_bind(); });  // (bound: connections wait in the backlog)
+  }
+  ~ArtifactServer() {
+    http.stop();
+    thread.join();
+  }
+  std::string url() const { return "http://127.0.0.1:" + std::to_string(port); }
+};
+
+// An artifact a lease renders with (a guide) is fetched once, checked against its hash, decoded,
+// counted in the worker's memory as it costs (Artifact::memory_bytes), and evicted beyond the
+// budget like a scene.
+TEST(SceneCache, ArtifactsAreFetchedOnceCheckedAndCountedAgainstTheBudget) {
+  TempDir dir;
+  ArtifactServer server;
+  Bounds3 box;
+  box.extend(Vec3(0.f, 0.f, 0.f));
+  box.extend(Vec3(1.f, 1.f, 1.f));
+  SpatialTree grown(box);
+  GuidingSettings settings;
+  settings.spatial_threshold = 1;
+  for (int i = 0; i < 64; ++i) grown.record(grown.leaf_of(Vec3(0.1f, 0.2f, 0.3f)), Vec3(0, 0, 1), 1.f, 0.5f);
+  grown.end_iteration(0, settings);
+  const std::string bytes = encode_guide(grown), hash = sha256_hex(bytes);
+  server.by_hash[hash] = bytes;
+  const std::string wrong = std::string(64, 'a');
+  server.by_hash[wrong] = bytes;  // (bytes that are not what their name says)
+  const client::FarmApi api{client::FarmClient(server.url())};
+  Lease lease;
+  lease.job_id = 3;
+  lease.guide = Lease::Guide{hash, 1, false};
+  {
+    farm::SceneCache cache(dir.path.string(), uint64_t(1) << 30);
+    auto first = cache.guide(lease, api);
+    auto again = cache.guide(lease, api);
+    EXPECT_EQ(first.get(), again.get());
+    EXPECT_EQ(server.requests.load(), 1) << "fetched once";
+    ASSERT_TRUE(first->guide);
+    EXPECT_TRUE(*first->guide == grown) << "decoded to the tree it encodes";
+    EXPECT_EQ(first->bytes, grown.bytes());
+    EXPECT_EQ(cache.memory().scene_bytes, grown.bytes()) << "what a heartbeat reports";
+    Lease corrupt = lease;
+    corrupt.guide->hash = wrong;
+    try {
+      (void)cache.guide(corrupt, api);
+      ADD_FAILURE() << "a guide whose bytes are not its hash's was taken";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("hash mismatch"), std::string::npos) << e.what();
+    }
+  }
+  farm::SceneCache tight(dir.path.string(), /*budget=*/1);
+  Lease scene = cached_lease(dir, kXml, 8);
+  (void)tight.guide(lease, api);
+  EXPECT_EQ(tight.loaded_scenes(), 1u);
+  (void)tight.get(scene, api);  // the guide is not in use: evicted for the scene
+  EXPECT_EQ(tight.loaded_scenes(), 1u);
+  EXPECT_EQ(tight.memory().scenes, 1u);
 }
 
 }  // namespace
