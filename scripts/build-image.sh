@@ -133,7 +133,7 @@ t0=$SECONDS
 # HEALTHCHECK (the OCI format has none).
 from=()
 if [ -n "$programs" ]; then
-  from=(--build-arg PROGRAMS=prebuilt --build-context "host-build=$(cd "$programs" && pwd)")
+  from=(--target prebuilt --build-context "host-build=$(cd "$programs" && pwd)")
   echo "build-image: the programs are $programs's (not compiled again)"
 fi
 podman build --pull=never --format docker "${from[@]}" -f docker/Dockerfile -t "$tag" .

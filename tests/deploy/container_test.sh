@@ -66,7 +66,7 @@ trap 'exit 130' INT TERM HUP
 # --- the image -----------------------------------------------------------------------------------
 # With the programs this host has just built and tested (stripped, as the build stage installs
 # them), not compiled a second time: the same Debian 12 compiler and flags make the same binaries
-# (docker/Dockerfile, PROGRAMS). TESSERA_CONTAINER_COMPILE=1 compiles them in the image instead.
+# (docker/Dockerfile, target prebuilt). TESSERA_CONTAINER_COMPILE=1 compiles them in the image.
 t0=$SECONDS
 programs=()
 if [ "${TESSERA_CONTAINER_COMPILE:-0}" != 1 ]; then
