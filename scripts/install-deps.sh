@@ -17,12 +17,13 @@ build_packages=(
 )
 
 # The tests on top of the build: GoogleTest, the tools test scripts call (OpenImageIO's read the
-# AOV layers; jsonschema checks the farm's answers against docs/openapi.json), the dashboard's browser test, and tests/deploy/container_test.sh, which makes a
+# AOV layers; jsonschema checks the farm's answers against docs/openapi.json; clang-tidy runs the
+# clang stage, scripts/clang-checks.sh), the dashboard's browser test, and tests/deploy/container_test.sh, which makes a
 # Debian base with debootstrap and builds and runs the image with podman. runc is named so apt does not pick crun for podman (crun fails on some
 # cgroup v1 hosts, docker/podman-env.sh); catatonit is compose's `init: true`, netavark and
 # aardvark-dns the network and service names, iptables its port publishing.
 test_packages=(
-  libgtest-dev libgmock-dev
+  libgtest-dev libgmock-dev clang-tidy
   curl bc openssl jq openimageio-tools
   python3-yaml python3-jsonschema iproute2
   chromium chromium-driver python3-selenium

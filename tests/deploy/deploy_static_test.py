@@ -234,7 +234,7 @@ def runtime_packages(root):
 
 
 # Packages only the tests use: the image's build stage (install-deps.sh --build) must not install them.
-TEST_ONLY = {"libgtest-dev", "libgmock-dev", "python3-yaml", "iproute2", "chromium", "chromium-driver",
+TEST_ONLY = {"libgtest-dev", "libgmock-dev", "clang-tidy", "python3-yaml", "iproute2", "chromium", "chromium-driver",
              "python3-selenium", "podman", "podman-compose", "buildah", "runc", "debootstrap"}
 
 
