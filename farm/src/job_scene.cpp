@@ -1,6 +1,7 @@
 #include "tessera/farm/job_scene.h"
 
 #include "tessera/farm/bundle.h"
+#include "tessera/farm/program_json.h"
 #include "tessera/guiding/tree_io.h"
 #include "tessera/render/light_sampler.h"
 #include "tessera/sequence/renderer.h"
@@ -60,11 +61,16 @@ JobPlan make_job_plan(const std::string& bundle_dir, const std::string& scene_fi
       throw SceneError(FileLoc{scene_file, 0}, "the scene references '" + f + "', which is outside its bundle");
     if (std::find(plan.files.begin(), plan.files.end(), rel) == plan.files.end()) plan.files.push_back(rel);
   }
+  plan.program = path_program(path_options(plan));
   return plan;
 }
 
 PathProgramOptions path_options(const JobPlan& plan) {
   return {uint32_t(plan.settings.spp), plan.settings.target_error, plan.settings.adaptive, AdaptiveSettings{}, plan.guide};
+}
+
+PassProgram job_program(const JobPlan& plan) {
+  return plan.program.passes.empty() ? path_program(path_options(plan)) : plan.program;
 }
 
 void begin_tile_result(const Lease& lease, TileResult& out) {
@@ -85,6 +91,8 @@ TileResult render_lease(const Scene& scene, const Lease& lease, const SpatialTre
                                   ? PassSamples::uniform(lease.rect, lease.sample_begin, lease.sample_end)
                                   : lease.samples;
   if (lease.guide && !guide) throw std::invalid_argument("render_lease: a guided lease without its guide");
+  // (The path tracer's passes are Tile passes; a technique that traces light paths renders those.)
+  if (lease.paths) throw std::invalid_argument("render_lease: the path tracer renders no unit of light paths");
   // Training goes into a recorder of the guide, whose nonzero sums travel with the result.
   std::optional<SpatialTree> recorder;
   if (lease.guide && lease.guide->train) recorder = make_recorder(*guide);
@@ -145,7 +153,8 @@ nlohmann::json to_json(const JobPlan& p) {
           {"ldr", p.ldr},
           {"gamma", p.gamma},
           {"exposure", p.exposure},
-          {"guide", p.guide ? guide_json(*p.guide) : json(nullptr)}};
+          {"guide", p.guide ? guide_json(*p.guide) : json(nullptr)},
+          {"program", to_json(p.program)}};
 }
 
 bool job_plan_from_json(const nlohmann::json& j, JobPlan& out, std::string& error) {
@@ -163,6 +172,9 @@ bool job_plan_from_json(const nlohmann::json& j, JobPlan& out, std::string& erro
     out.exposure = j.at("exposure").get<float>();
     out.guide.reset();
     if (j.contains("guide") && !j["guide"].is_null()) out.guide = guide_from_json(j["guide"]);
+    // (A plan stored before programs were kept has none: its settings give it, job_program().)
+    out.program = PassProgram{};
+    if (j.contains("program") && !program_from_json(j["program"], out.program, error)) return false;
     return true;
   } catch (const std::exception& e) {
     error = std::string("job plan: ") + e.what();

@@ -255,6 +255,7 @@ json lease_own_json(const Lease& l) {
     j["count"] = l.samples.count;
   }
   if (l.guide) j["guide"] = {{"hash", l.guide->hash}, {"iteration", l.guide->iteration}, {"train", l.guide->train}};
+  if (l.paths) j["paths"] = {l.paths->first, l.paths->second};
   return j;
 }
 
@@ -310,6 +311,8 @@ bool lease_from_json(const json& j, Lease& out, std::string& error) {
   f.get("seconds_to_expiry", out.seconds_to_expiry);
   json guide;
   f.get("guide", guide);
+  std::vector<uint64_t> paths;
+  f.get("paths", paths);
   f.get("settings", settings, true);
   f.get("scene_file", out.scene_file, true);
   f.get_list("files", out.files);
@@ -326,6 +329,14 @@ bool lease_from_json(const json& j, Lease& out, std::string& error) {
   }
   out.samples.rect = out.rect;
   if (!lease_samples_valid(out, error)) return false;
+  out.paths.reset();
+  if (!paths.empty()) {
+    if (paths.size() != 2 || paths[1] <= paths[0] || !out.samples.count.empty()) {
+      error = "lease: 'paths' must be [begin, end] with begin < end, on a lease without per-pixel samples";
+      return false;
+    }
+    out.paths = std::pair{paths[0], paths[1]};
+  }
   out.guide.reset();
   if (!guide.is_null()) {
     Lease::Guide g;

@@ -69,7 +69,7 @@ namespace {
 // A job that ended has its image on disk: only its bookkeeping is rebuilt, not its film.
 std::unique_ptr<JobState> ended_job(Store& store, std::unique_ptr<JobState> job) {
   store.for_each_result(job->id(), [&](ResultRow&& r) {
-    if (r.tile < job->num_tiles() && r.pass < job->num_passes()) job->mark_done(job->unit(r.tile, r.pass), r.worker);
+    if (job->has_unit(r.tile, r.pass)) job->mark_done(job->unit(r.tile, r.pass), r.worker);
   }, /*with_data=*/false);
   if (job->phase() == JobPhase::Done && job->done_units() < job->num_units()) job->restore_converged();
   job->release_film();

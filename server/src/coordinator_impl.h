@@ -20,6 +20,7 @@
 #include "scheduler.h"
 #include "webhooks.h"
 #include "worker_registry.h"
+#include "unit_upload.h"
 #include "tessera/core/mutex.h"
 #include "tessera/farm/build_fingerprint.h"
 #include "tessera/farm/tile_result.h"
@@ -107,19 +108,21 @@ struct Coordinator::Impl {
   void reap_loop() TESSERA_EXCLUDES(mu);
 
   // Results (coordinator_results.cpp).
-  /// The unit an uploaded result is for, once worker, job and unit check out.
-  Result<size_t> check_result(uint64_t worker, const TileResult& result) TESSERA_REQUIRES(mu);
+  /// The unit an uploaded result is for, once worker, job and unit (and the result's kind) check out.
+  Result<size_t> check_result(uint64_t worker, const UnitUpload& upload) TESSERA_REQUIRES(mu);
+  Status check_tile_result(const JobState& job, size_t unit, const TileResult& result);
+  Status check_splat_result(const JobState& job, size_t unit, const SplatResult& result);
   /// Appends a checked result for `unit` (now committing) to the group commit; its ticket. Once
   /// durable, result_committed adds it to the job.
-  uint64_t commit_result(JobState& job, size_t unit, uint64_t worker, const std::shared_ptr<TileResult>& result,
-                         std::string_view bytes) TESSERA_REQUIRES(mu);
+  uint64_t commit_result(JobState& job, size_t unit, uint64_t worker, const UnitUpload& upload, std::string_view bytes)
+      TESSERA_REQUIRES(mu);
   /// Once durable (a group-commit callback): the result enters its job, which may then be done;
   /// `durable` false: the unit is open again.
-  void result_committed(bool durable, uint64_t job, size_t unit, uint64_t worker, TileResult& result, size_t bytes)
+  void result_committed(bool durable, uint64_t job, size_t unit, uint64_t worker, const UnitUpload& upload, size_t bytes)
       TESSERA_REQUIRES(mu);
   /// A second result for a done unit is dropped, and compared with the first when its digest was
   /// kept (a mismatch is counted and logged as an error).
-  void check_duplicate(JobState& job, size_t unit, uint64_t worker, const FilmTile& film) TESSERA_REQUIRES(mu);
+  void check_duplicate(JobState& job, size_t unit, uint64_t worker, const Sha256Digest& digest) TESSERA_REQUIRES(mu);
   /// Appends the tile's checkpoint once `min_new` more passes are in its film (encoded by the
   /// writer, not under `mu`).
   void checkpoint_tile(JobState& job, uint32_t tile, uint32_t min_new) TESSERA_REQUIRES(mu);

@@ -71,6 +71,7 @@ Coordinator::Impl::IssuedLease Coordinator::Impl::issue_lease(uint64_t worker, W
   l.sample_begin = job.sample_begin(unit);
   l.sample_end = job.sample_end(unit);
   if (std::optional<PassSamples> samples = job.lease_samples(unit)) l.samples = std::move(*samples);
+  if (!job.is_tile_unit(unit)) l.paths = job.paths(unit);
   l.guide = job.lease_guide(unit);
   l.seconds_to_expiry = opt.heartbeat_interval * kMissedHeartbeats;
   l.settings = job.plan().settings;
@@ -175,8 +176,7 @@ bool Coordinator::Impl::keep_lease(uint64_t worker, const HeldLease& held) {
   // Unknown (ended while its worker was thought dead, or logged by a process before a restart
   // that did not hold it): kept if its work is still wanted.
   const JobState* job = jobs.find(held.job);
-  if (!job || is_terminal(job->phase()) || held.tile >= job->num_tiles() || held.pass >= job->num_passes())
-    return false;
+  if (!job || is_terminal(job->phase()) || !job->has_unit(held.tile, held.pass)) return false;
   const size_t unit = job->unit(held.tile, held.pass);
   if (job->is_done(unit)) return false;
   add_lease(LeaseInfo{held.id, held.job, worker, unit, Clock::now() + dead_after()});
@@ -187,7 +187,7 @@ void Coordinator::Impl::hold_open_leases(JobState& job) {
   // Their workers may still be rendering them: a heartbeat naming the lease re-adopts it, and only
   // a unit nobody claims within dead_after() is leased again (never rendered twice for a restart).
   for (const LeaseRow& l : store.open_leases(job.id())) {
-    if (l.tile >= job.num_tiles() || l.pass >= job.num_passes()) continue;
+    if (!job.has_unit(l.tile, l.pass)) continue;
     const size_t unit = job.unit(l.tile, l.pass);
     if (job.is_done(unit)) continue;
     add_lease(LeaseInfo{l.id, job.id(), l.worker, unit, Clock::now() + dead_after()});

@@ -26,23 +26,11 @@ Status Coordinator::Impl::durable(uint64_t ticket) {
   }
 }
 
-Result<size_t> Coordinator::Impl::check_result(uint64_t worker, const TileResult& result) {
-  WorkerInfo* w = workers.find(worker);
-  if (!w) return unknown_worker(worker);
-  saw_worker(worker, *w);
-  JobState* found = jobs.find(result.job_id);
-  if (!found) return unknown_job(result.job_id);
-  JobState& job = *found;
-  if (job.phase() == JobPhase::Cancelled || job.phase() == JobPhase::Failed)
-    return make_error(Code::Gone, "job_ended", "job " + std::to_string(job.id()) + " is " + phase_name(job.phase()));
-  if (result.tile >= job.num_tiles() || result.pass >= job.num_passes())
-    return make_error(Code::BadRequest, "bad_result", "tile or pass out of range for job " + std::to_string(job.id()));
-  const size_t unit = job.unit(result.tile, result.pass);
+Status Coordinator::Impl::check_tile_result(const JobState& job, size_t unit, const TileResult& result) {
   if (!(result.film.rect() == job.rect(unit)) || result.sample_begin != job.sample_begin(unit) ||
       result.sample_end != job.sample_end(unit))
     return make_error(Code::BadRequest, "bad_result", "the result's rectangle or samples do not match the unit");
-  // (A late copy of a done unit is answered as a duplicate, its sums compared with the accepted ones.)
-  if (job.is_done(unit)) return unit;
+  if (job.is_done(unit)) return Status::success();  // (a late copy: a duplicate, compared with the first)
   if (result.film.has_aovs() != job.plan().settings.denoise)
     return make_error(Code::BadRequest, "bad_result",
                       job.plan().settings.denoise ? "a result of a denoised job must carry the AOV sums (format version 4)"
@@ -50,13 +38,41 @@ Result<size_t> Coordinator::Impl::check_result(uint64_t worker, const TileResult
   if (!job.result_fits(unit, result.film))
     return make_error(Code::BadRequest, "bad_result",
                       "the result's per-pixel sample counts are not those its adaptive pass gives the tile");
+  return Status::success();
+}
+
+Status Coordinator::Impl::check_splat_result(const JobState& job, size_t unit, const SplatResult& result) {
+  if (!(result.splats.window == job.plan().window) || std::pair{result.path_begin, result.path_end} != job.paths(unit))
+    return make_error(Code::BadRequest, "bad_result", "the result's window or light paths do not match the unit");
+  return Status::success();
+}
+
+Result<size_t> Coordinator::Impl::check_result(uint64_t worker, const UnitUpload& upload) {
+  WorkerInfo* w = workers.find(worker);
+  if (!w) return unknown_worker(worker);
+  saw_worker(worker, *w);
+  JobState* found = jobs.find(upload.job());
+  if (!found) return unknown_job(upload.job());
+  JobState& job = *found;
+  if (job.phase() == JobPhase::Cancelled || job.phase() == JobPhase::Failed)
+    return make_error(Code::Gone, "job_ended", "job " + std::to_string(job.id()) + " is " + phase_name(job.phase()));
+  if (!job.has_unit(upload.index(), upload.pass()))
+    return make_error(Code::BadRequest, "bad_result", "tile or pass out of range for job " + std::to_string(job.id()));
+  const size_t unit = job.unit(upload.index(), upload.pass());
+  if (job.is_tile_unit(unit) != bool(upload.tile))
+    return make_error(Code::BadRequest, "bad_result",
+                      job.is_tile_unit(unit) ? "a splat result for a unit of a tile" : "a tile result for a unit of light paths");
+  if (Status st = upload.tile ? check_tile_result(job, unit, *upload.tile) : check_splat_result(job, unit, *upload.splats);
+      !st.ok())
+    return st;
   std::string error;
-  if (!job.check_training(unit, result.training, error)) return make_error(Code::BadRequest, "bad_result", error);
+  if (!job.is_done(unit) && !job.check_training(unit, upload.records(), error))
+    return make_error(Code::BadRequest, "bad_result", error);
   return unit;
 }
 
 void Coordinator::Impl::result_committed(bool durable, uint64_t job_id, size_t unit, uint64_t worker,
-                                         TileResult& result, size_t bytes) {
+                                         const UnitUpload& upload, size_t bytes) {
   JobState* found = jobs.find(job_id);
   if (!found) return;
   JobState& job = *found;
@@ -66,47 +82,50 @@ void Coordinator::Impl::result_committed(bool durable, uint64_t job_id, size_t u
     return;
   }
   const uint64_t samples = job.unit_samples(unit);
-  if (!job.add_result(unit, std::move(result.film), worker, result.training)) return;  // (a retry rebuilt it meanwhile)
+  const bool added = upload.tile ? job.add_result(unit, std::move(upload.tile->film), worker, upload.records())
+                                 : job.add_splats(unit, std::move(upload.splats->splats), worker, upload.records());
+  if (!added) return;  // (a retry rebuilt it meanwhile)
   save_decisions(job);
-  checkpoint_tile(job, job.tile_of(unit), 1);
+  if (upload.tile) checkpoint_tile(job, job.tile_of(unit), 1);
   job.result_bytes += bytes;
   ++metrics.counters.done;
   metrics.counters.bytes_in += bytes;
   if (WorkerInfo* w = workers.find(worker)) {
     w->units_done += 1;
     w->samples_done += samples;
-    w->render_seconds += result.seconds;
+    w->render_seconds += upload.seconds();
   }
   log_event(spdlog::level::debug, "lease.done",
-            {{"job", job.id()}, {"unit", unit}, {"worker", worker}, {"seconds", result.seconds}});
+            {{"job", job.id()}, {"unit", unit}, {"worker", worker}, {"seconds", upload.seconds()}});
   // (The phase is kept until durable; a crash before that finds the job complete at start-up.)
   if (!is_terminal(job.phase()) && job.complete()) complete_job(job);
 }
 
-uint64_t Coordinator::Impl::commit_result(JobState& job, size_t unit, uint64_t worker,
-                                          const std::shared_ptr<TileResult>& result, std::string_view bytes) {
+uint64_t Coordinator::Impl::commit_result(JobState& job, size_t unit, uint64_t worker, const UnitUpload& upload,
+                                          std::string_view bytes) {
   // The tile's next pass with all before it checkpointed: stored as the tile's new checkpoint (its
   // own bytes never stored). Otherwise stored as it came, and folded in later.
   std::shared_ptr<JobState::Checkpoint> cp;
-  if (auto with = job.checkpoint_with(unit, result->film)) cp = std::make_shared<JobState::Checkpoint>(std::move(*with));
+  if (upload.tile)
+    if (auto with = job.checkpoint_with(unit, upload.tile->film)) cp = std::make_shared<JobState::Checkpoint>(std::move(*with));
   job.start_commit(unit);
   // Another copy is still being rendered (speculative, or re-issued from a worker thought dead):
   // its result will be checked against this one.
-  if (job.active_leases(unit) > 0) job.remember_digest(unit, tile_digest(result->film));
+  if (job.active_leases(unit) > 0) job.remember_digest(unit, upload.digest());
   return commits.append(
-      [id = job.id(), tile = result->tile, pass = result->pass, worker, cp, result, data = cp ? "" : std::string(bytes),
-       now = wall_seconds()](Store& st) {
-        (void)st.add_result(id, tile, pass, worker, data, now);
-        if (!result->training.empty()) st.save_training(id, tile, pass, result->training);
+      [id = job.id(), index = upload.index(), pass = upload.pass(), worker, cp, records = upload.records(),
+       data = cp ? "" : std::string(bytes), now = wall_seconds()](Store& st) {
+        (void)st.add_result(id, index, pass, worker, data, now);
+        if (!records.empty()) st.save_training(id, index, pass, records);
         // (This pass's row is stored without its bytes and the earlier ones' were dropped: nothing
         // for the checkpoint to drop, hence `from` = `passes`.)
-        if (cp) st.save_checkpoint(id, tile, cp->passes, cp->passes, encode_checkpoint(id, *cp));
+        if (cp) st.save_checkpoint(id, index, cp->passes, cp->passes, encode_checkpoint(id, *cp));
       },
       GroupCommit::Retry::No,
-      [this, id = job.id(), unit, worker, result, cp, n = bytes.size()](bool durable) TESSERA_REQUIRES(mu) {
+      [this, id = job.id(), unit, worker, upload, cp, n = bytes.size()](bool durable) TESSERA_REQUIRES(mu) {
         JobState* job = jobs.find(id);
         if (durable && cp && job) job->checkpoint_stored(cp->tile, cp->passes);
-        result_committed(durable, id, unit, worker, *result, n);
+        result_committed(durable, id, unit, worker, upload, n);
       });
 }
 
@@ -125,11 +144,11 @@ void Coordinator::Impl::checkpoint_tile(JobState& job, uint32_t tile, uint32_t m
       });
 }
 
-void Coordinator::Impl::check_duplicate(JobState& job, size_t unit, uint64_t worker, const FilmTile& film) {
+void Coordinator::Impl::check_duplicate(JobState& job, size_t unit, uint64_t worker, const Sha256Digest& digest) {
   ++job.duplicates;
   ++metrics.counters.duplicates;
   const Sha256Digest* first = job.digest(unit);
-  if (!first || *first == tile_digest(film)) return;
+  if (!first || *first == digest) return;
   // Renders are deterministic: a different answer for the same unit means a broken worker.
   ++job.mismatched;
   ++metrics.counters.mismatched;
@@ -143,6 +162,11 @@ BodyLimit Coordinator::result_limit(uint64_t worker, uint64_t lease) {
     MutexLock lock(s.mu);
     const LeaseInfo* l = s.leases.find(lease);
     const JobState* job = l && l->worker == worker ? s.jobs.find(l->job) : nullptr;
+    if (job && !job->is_tile_unit(l->unit)) {
+      const auto [begin, end] = job->paths(l->unit);
+      return {max_splat_result_bytes(end - begin, kMaxTrainingBytes),
+              "a result of lease " + std::to_string(lease) + " (" + std::to_string(end - begin) + " light paths)"};
+    }
     if (job) {
       const TileRect& r = job->rect(l->unit);
       const bool aovs = job->plan().settings.denoise, training = job->sequencer().pass(job->pass_of(l->unit)).feeds.has_value();
@@ -161,10 +185,9 @@ BodyLimit Coordinator::result_limit(uint64_t worker, uint64_t lease) {
 Result<ResultAck> Coordinator::upload_result(uint64_t worker, uint64_t /*lease*/, std::string_view bytes, bool next) {
   Impl& s = *impl_;
   const auto t0 = Clock::now();
-  auto result = std::make_shared<TileResult>();
-  std::string error;
-  if (!decode_tile_result(bytes, *result, error, s.opt.limits.max_pixels))
-    return make_error(Code::BadRequest, "bad_result", error);
+  Result<UnitUpload> decoded = decode_upload(bytes, s.opt.limits.max_pixels);  // (off the lock)
+  if (!decoded.ok()) return decoded.status;
+  const UnitUpload& upload = decoded.value;
   s.adopt_worker(worker);
   // Decided here and appended to the group commit; its callback adds it to the job once durable.
   ResultAck ack{/*accepted=*/true, /*duplicate=*/false, next, std::nullopt};
@@ -172,21 +195,21 @@ Result<ResultAck> Coordinator::upload_result(uint64_t worker, uint64_t /*lease*/
   std::optional<Impl::IssuedLease> issued;
   {
     MutexLock lock(s.mu);
-    Result<size_t> checked = s.check_result(worker, *result);
+    Result<size_t> checked = s.check_result(worker, upload);
     if (!checked.ok()) return checked.status;
     const size_t unit = checked.value;
-    JobState& job = *s.jobs.find(result->job_id);
+    JobState& job = *s.jobs.find(upload.job());
     for (uint64_t id : s.leases.of_unit(job.id(), unit))
       if (s.leases.find(id)->worker == worker) s.end_lease(id);
     if (job.is_done(unit) && job.accepted_from(unit) == worker) {
       // The same worker again: a retry of an upload whose answer was lost (the coordinator
       // restarted, or the connection broke), not a second render. Answered as it was the first time.
     } else if (job.is_done(unit) || job.is_committing(unit)) {
-      s.check_duplicate(job, unit, worker, result->film);
+      s.check_duplicate(job, unit, worker, upload.digest());
       ack.accepted = false;
       ack.duplicate = true;
     } else {
-      ticket = s.commit_result(job, unit, worker, result, bytes);
+      ticket = s.commit_result(job, unit, worker, upload, bytes);
     }
     if (next) issued = s.next_lease(worker);  // (logged after the result: one commit for both)
   }

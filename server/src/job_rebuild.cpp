@@ -68,18 +68,19 @@ std::unique_ptr<JobState> Coordinator::Impl::rebuild_job(const JobRow& row) {
     job->restore_checkpoint(c.tile, c.passes, std::move(sums.film));
   });
   store.for_each_result(row.id, [&](ResultRow&& r) {
-    if (r.tile >= job->num_tiles() || r.pass >= job->num_passes()) return;
+    if (!job->has_unit(r.tile, r.pass)) return;
     const size_t unit = job->unit(r.tile, r.pass);
     if (!job->pass_decided(r.pass))
       throw std::runtime_error(where + "a result of pass " + std::to_string(r.pass) + " without its stored sample counts");
-    if (r.data.empty() || r.pass < job->passes_in_film(r.tile))
+    if (r.data.empty() || (job->is_tile_unit(unit) && r.pass < job->passes_in_film(r.tile)))
       return job->mark_done(unit, r.worker);  // (held by its tile's checkpoint)
-    TileResult result;
-    std::string err;
-    if (!decode_tile_result(r.data, result, err)) throw std::runtime_error(where + "stored result is corrupt: " + err);
-    if (result.film.has_aovs() != job->plan().settings.denoise)
-      throw std::runtime_error(where + "a stored result of pass " + std::to_string(r.pass) + " does not fit the job's AOVs");
-    (void)job->add_result(unit, std::move(result.film), r.worker);
+    Result<UnitUpload> stored = decode_upload(r.data, int64_t(1) << 30);
+    if (!stored.ok()) throw std::runtime_error(where + "stored result is corrupt: " + stored.status.detail);
+    const UnitUpload& u = stored.value;
+    if (job->is_tile_unit(unit) != bool(u.tile) || (u.tile && u.tile->film.has_aovs() != job->plan().settings.denoise))
+      throw std::runtime_error(where + "a stored result of pass " + std::to_string(r.pass) + " does not fit the job");
+    (void)(u.tile ? job->add_result(unit, std::move(u.tile->film), r.worker)
+                  : job->add_splats(unit, std::move(u.splats->splats), r.worker));
   });
   job->end_rebuild();
   return job;

@@ -25,16 +25,18 @@ bool parse_phase(const std::string& s, JobPhase& out) {
 std::string farm_program_error(const PassProgram& program) {
   if (program.films != 1) return "the farm combines one film per job";
   for (const PassSpec& p : program.passes)
-    if (p.kind != UnitKind::Tile || p.tile_state) return "the farm renders Tile passes without per-tile state";
+    if (p.tile_state) return "the farm carries no per-tile state from a pass to the next";
   return {};
 }
 
 namespace {
 
 PassSequencer job_sequencer(const JobPlan& plan) {
-  // The same sequencer `tessera render` runs with these settings (path_program.h).
-  PassSequencer seq = path_sequencer(path_options(plan), SequenceFrame{plan.window, plan.full_width, plan.full_height,
-                                                                      plan.settings.tile_size, plan.settings.denoise});
+  // The same sequencer `tessera render` runs with these settings (path_program.h), with the passes
+  // planned at submission.
+  PassSequencer seq = path_sequencer(job_program(plan), SequenceFrame{plan.window, plan.full_width, plan.full_height,
+                                                                  plan.settings.tile_size, plan.settings.denoise},
+                                     plan.guide);
   if (std::string e = farm_program_error(seq.program()); !e.empty()) throw std::invalid_argument(e);
   return seq;
 }
@@ -90,13 +92,13 @@ void JobState::lease_ended(size_t unit) {
 
 void JobState::start_commit(size_t unit) {
   committing_[unit] = 1;
-  ++tile_committing_[tile_of(unit)];
+  if (is_tile_unit(unit)) ++tile_committing_[tile_of(unit)];
 }
 
 void JobState::commit_failed(size_t unit) {
   if (committing_[unit]) {
     committing_[unit] = 0;
-    --tile_committing_[tile_of(unit)];
+    if (is_tile_unit(unit)) --tile_committing_[tile_of(unit)];
     if (unit < cursor_) returned_.insert(unit);
   }
   digests_.erase(unit);
@@ -109,22 +111,33 @@ void JobState::mark_done(size_t unit, uint64_t worker) {
   samples_by_worker_[worker] += unit_samples(unit);
 }
 
-bool JobState::add_result(size_t unit, FilmTile&& tile, uint64_t worker, std::string_view training) {
+bool JobState::add_unit_result(size_t unit, UnitResult&& result, uint64_t worker) {
   if (is_done(unit)) {
     ++duplicates;
     return false;
   }
   if (committing_[unit]) {
     committing_[unit] = 0;
-    --tile_committing_[tile_of(unit)];
+    if (is_tile_unit(unit)) --tile_committing_[tile_of(unit)];
   }
   accepted_from_[unit] = worker;
   samples_by_worker_[worker] += unit_samples(unit);  // (before a barrier it completes decides the next pass)
+  (void)seq_.add_result(unit, std::move(result));
+  return true;
+}
+
+bool JobState::add_result(size_t unit, FilmTile&& tile, uint64_t worker, std::string_view training) {
   UnitResult result;
   result.tile = std::move(tile);
   result.records = std::string(training);
-  (void)seq_.add_result(unit, std::move(result));
-  return true;
+  return add_unit_result(unit, std::move(result), worker);
+}
+
+bool JobState::add_splats(size_t unit, SplatSums&& splats, uint64_t worker, std::string_view records) {
+  UnitResult result;
+  result.splats = std::move(splats);
+  result.records = std::string(records);
+  return add_unit_result(unit, std::move(result), worker);
 }
 
 // The tile's region of the film (zero before the film exists) with its passes' counters.
@@ -147,6 +160,7 @@ std::optional<JobState::Checkpoint> JobState::take_checkpoint(uint32_t t, uint32
 }
 
 std::optional<JobState::Checkpoint> JobState::checkpoint_with(size_t u, const FilmTile& result) const {
+  if (!is_tile_unit(u)) return std::nullopt;  // (a Paths unit's result is stored as it came)
   const uint32_t t = tile_of(u);
   if (!has_film() || pass_of(u) != passes_in_film(t) || folded_[t] != passes_in_film(t) || tile_committing_[t] > 0)
     return std::nullopt;

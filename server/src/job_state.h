@@ -28,7 +28,7 @@ const char* phase_name(JobPhase p);
 bool parse_phase(const std::string& s, JobPhase& out);
 inline bool is_terminal(JobPhase p) { return p == JobPhase::Done || p == JobPhase::Failed || p == JobPhase::Cancelled; }
 
-/// Whether the farm can run `program`: Tile passes into one film. (Paths units' splats and
+/// Whether the farm can run `program`: Tile and Paths passes into one film. (Per-tile state and
 /// per-iteration films have no wire format or checkpoint yet; the sequencer runs them locally.)
 std::string farm_program_error(const PassProgram& program);
 
@@ -43,7 +43,8 @@ class JobState {
   double created() const { return created_; }
   const PassSequencer& sequencer() const { return seq_; }
 
-  // Units: the sequencer's, pass-major; every pass of a farm job is a Tile pass.
+  // Units: the sequencer's, pass-major. A unit is named (index, pass) on the wire and in the store,
+  // where the index is its tile in a Tile pass and its range of paths in a Paths pass.
   size_t num_tiles() const { return seq_.num_tiles(); }
   size_t num_passes() const { return seq_.num_passes(); }
   size_t num_units() const { return seq_.num_units(); }
@@ -51,7 +52,16 @@ class JobState {
   uint32_t tile_of(size_t unit) const { return seq_.index_of(unit); }
   uint32_t pass_of(size_t unit) const { return seq_.pass_of(unit); }
   size_t unit(uint32_t tile, uint32_t pass) const { return seq_.unit(pass, tile); }
-  const TileRect& rect(size_t unit) const { return seq_.tiles()[tile_of(unit)]; }
+  /// Whether (index, pass) names a unit of the job.
+  bool has_unit(uint32_t index, uint32_t pass) const { return pass < num_passes() && index < seq_.units_in(pass); }
+  bool is_tile_unit(size_t unit) const { return seq_.pass(pass_of(unit)).kind == UnitKind::Tile; }
+  /// A Tile unit's tile; a Paths unit's result covers the whole window.
+  const TileRect& rect(size_t unit) const { return is_tile_unit(unit) ? seq_.tiles()[tile_of(unit)] : plan_.window; }
+  /// A Paths unit's light paths.
+  std::pair<uint64_t, uint64_t> paths(size_t unit) const {
+    const UnitWork w = seq_.work(unit);
+    return {w.path_begin, w.path_end};
+  }
   uint32_t sample_begin(size_t unit) const { return seq_.pass(pass_of(unit)).sample_begin; }
   uint32_t sample_end(size_t unit) const { return sample_begin(unit) + seq_.pass(pass_of(unit)).samples; }
   /// Samples of the unit (pixels x samples per pixel, or an adaptive pass's counts): its work.
@@ -127,6 +137,8 @@ class JobState {
   /// Adds a verified result (with a training unit's records, checked); false when the unit was
   /// already done (a duplicate).
   bool add_result(size_t unit, FilmTile&& tile, uint64_t worker, std::string_view training = {});
+  /// The same for a Paths unit's splats.
+  bool add_splats(size_t unit, SplatSums&& splats, uint64_t worker, std::string_view records = {});
   /// Marks a unit done without its sums (a finished job resumed from its stored image, or a pass a
   /// tile's checkpoint holds).
   void mark_done(size_t unit, uint64_t worker);
@@ -201,6 +213,7 @@ class JobState {
 
  private:
   Checkpoint film_checkpoint(uint32_t tile) const;
+  bool add_unit_result(size_t unit, UnitResult&& result, uint64_t worker);
 
   friend class JobRegistry;
 
@@ -221,12 +234,6 @@ class JobState {
   mutable std::set<size_t> returned_;            // units behind the cursor handed back
   std::map<uint64_t, uint64_t> samples_by_worker_;
 };
-
-/// SHA-256 of a result's pixel sums: what two renders of one unit must agree on (the worker's
-/// timing in the result bytes differs).
-inline Sha256Digest tile_digest(const FilmTile& film) {
-  return sha256(film.pixels().data(), film.pixels().size() * sizeof(PixelSums));
-}
 
 /// The samples per pixel an image of the job holds once finished: the spp reached when it stopped
 /// at its target error, else its spp (what the EXR header's tessera_spp says).

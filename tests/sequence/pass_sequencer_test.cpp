@@ -190,8 +190,11 @@ TEST(PassSequencer, StopsAtTheTargetErrorAsARenderOfTheSamplesReached) {
   PassProgram program;
   program.spp = 24;
   program.target_error = 0.05;
-  for (uint32_t begin = 0, n = 1; begin < 24; begin += n, n = std::min(2 * n, 24 - begin - n))
+  uint32_t begin = 0;
+  for (uint32_t n : pass_schedule(24)) {
     program.passes.push_back(PassSpec{UnitKind::Tile, begin, n, begin > 0, false, begin > 0});
+    begin += n;
+  }
   const Outcome stopped = run_shuffled(program, 8, kSeed, 4);
   ASSERT_TRUE(stopped.stopped);
   ASSERT_LT(stopped.spp, 24u);

@@ -178,17 +178,18 @@ std::optional<Lease> Worker::process(const Lease& lease) {
     return dropped;
   };
   std::shared_ptr<const CachedScene> scene, guide;
+  TileResult result;
   try {
     scene = cache_.get(lease, api_);
     if (lease.guide) guide = cache_.guide(lease, api_);
-  } catch (const std::exception& e) {
+    result = render_lease(*scene->scene, lease, guide ? guide->guide.get() : nullptr);
+  } catch (const std::exception& e) {  // (a scene that does not load, a unit this build cannot render)
     finish();
     ++stats_.failures;
-    spdlog::error("job {}: cannot load the scene: {}", lease.job_id, e.what());
+    spdlog::error("job {}: cannot render tile {} of pass {}: {}", lease.job_id, lease.tile, lease.pass, e.what());
     (void)api_.fail_lease(worker_id_.load(), lease.id, e.what());
     return std::nullopt;
   }
-  TileResult result = render_lease(*scene->scene, lease, guide ? guide->guide.get() : nullptr);
   ++stats_.passes_rendered;
   const bool dropped = finish();
   if (dropped) return std::nullopt;

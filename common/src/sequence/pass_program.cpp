@@ -39,6 +39,13 @@ std::string program_error(const PassProgram& program) {
     max_artifact = std::max(max_artifact, pass.uses.value_or(0));
     max_artifact = std::max(max_artifact, pass.feeds.value_or(0));
   }
+  uint32_t next_sample = 0;  // the passes take the sample indices 0 .. spp-1 in order
+  for (size_t p = 0; p < program.passes.size(); ++p) {
+    if (program.passes[p].sample_begin != next_sample || program.passes[p].samples == 0)
+      return "pass " + std::to_string(p) + ": its samples do not follow the pass before's";
+    next_sample += program.passes[p].samples;
+  }
+  if (next_sample != program.spp) return "the passes' samples do not add up to spp";
   std::vector<bool> used_before(size_t(max_artifact) + 1, false);
   for (size_t p = 0; p < program.passes.size(); ++p) {
     if (std::string e = pass_error(program, p, used_before); !e.empty()) return e;

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <stdexcept>
 
 namespace tessera {
 
@@ -51,10 +52,16 @@ PassProgram path_program(const PathProgramOptions& o) {
 }
 
 PassSequencer path_sequencer(const PathProgramOptions& options, const SequenceFrame& frame) {
-  PassProgram program = path_program(options);
+  return path_sequencer(path_program(options), frame, options.guide);
+}
+
+PassSequencer path_sequencer(PassProgram program, const SequenceFrame& frame, const std::optional<GuidePlan>& guide) {
   std::unique_ptr<ArtifactBuilder> training;
-  if (std::any_of(program.passes.begin(), program.passes.end(), [](const PassSpec& p) { return p.uses.has_value(); }))
-    training = std::make_unique<GuideTraining>(options.guide->bounds, options.guide->settings);
+  if (std::any_of(program.passes.begin(), program.passes.end(),
+                  [](const PassSpec& p) { return p.uses.has_value() || p.feeds.has_value(); })) {
+    if (!guide) throw std::invalid_argument("the passes render with guides, but there is no guide to train");
+    training = std::make_unique<GuideTraining>(guide->bounds, guide->settings);
+  }
   return PassSequencer(std::move(program), frame, std::move(training));
 }
 

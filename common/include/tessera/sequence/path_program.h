@@ -47,5 +47,8 @@ PassProgram path_program(const PathProgramOptions& options);
 /// The sequencer of that program over `frame`, with the guide's training (guide_training.h) as its
 /// artifact builder when a pass is guided.
 PassSequencer path_sequencer(const PathProgramOptions& options, const SequenceFrame& frame);
+/// The sequencer of a program kept as planned (a farm job's), its artifacts `guide`'s training.
+/// Throws std::invalid_argument when its passes render with artifacts and there is no guide.
+PassSequencer path_sequencer(PassProgram program, const SequenceFrame& frame, const std::optional<GuidePlan>& guide);
 
 }  // namespace tessera

@@ -27,11 +27,17 @@ struct JobPlan {
   /// A guided job: the SD-tree as render() starts it (over the scene's bounds) and its settings.
   using Guide = GuidePlan;
   std::optional<Guide> guide;
+  /// The passes the job was planned with (path_program() of path_options()): a coordinator that
+  /// resumes it runs these, whatever a later build would plan for the same settings.
+  PassProgram program;
 };
 
 /// The job's path-tracer options (sequence/path_program.h): the sequencer the coordinator runs
 /// is the one `tessera render` runs with the same settings.
 PathProgramOptions path_options(const JobPlan& plan);
+/// The job's passes: its plan's program, or (a plan without one: stored before programs were kept,
+/// or made by hand) the one its settings give.
+PassProgram job_program(const JobPlan& plan);
 
 struct LoadedJobScene {
   SceneDesc desc;

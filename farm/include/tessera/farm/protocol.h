@@ -70,7 +70,9 @@ struct JobRequest {
 [[nodiscard]] bool check_job_limits(const JobSettings& s, const JobLimits& limits, std::string& error);
 
 /// One unit of work: samples [sample_begin, sample_end) of every pixel of `rect`, or in an adaptive
-/// pass the samples `samples` gives each pixel (sample_begin/end then name the pass's nominal range).
+/// pass the samples `samples` gives each pixel (sample_begin/end then name the pass's nominal range);
+/// or, for a unit of a Paths pass (sequence/pass_program.h), the light paths `paths` ([begin, end)),
+/// whose result covers `rect`, the whole window (farm/splat_result.h), and `tile` its index in the pass.
 struct Lease {
   uint64_t id = 0;
   uint64_t job_id = 0;
@@ -78,6 +80,7 @@ struct Lease {
   TileRect rect;
   uint32_t sample_begin = 0, sample_end = 0;
   PassSamples samples;           // an adaptive pass's per-pixel samples over `rect`; else empty
+  std::optional<std::pair<uint64_t, uint64_t>> paths;  // a Paths unit's light paths
   double seconds_to_expiry = 0;  // heartbeat before this
   JobSettings settings;          // the job's, with spp/width/height resolved
   std::string scene_file;        // resolved XML path inside the bundle
