@@ -2,6 +2,7 @@
 #include "coordinator_impl.h"
 #include "disk_full.h"
 #include "event_log.h"
+#include "upload_spool.h"
 
 #include <spdlog/spdlog.h>
 
@@ -41,6 +42,7 @@ int http_status(Code code) {
 namespace {
 std::string prepare_data_dir(const std::string& dir) {
   for (const char* sub : {"bundles", "scenes", "tmp", "images", "guides"}) fs::create_directories(fs::path(dir) / sub);
+  clear_spool((fs::path(dir) / "tmp").string());  // (uploads a crash cut short)
   return (fs::path(dir) / "state.sqlite").string();
 }
 }  // namespace
@@ -96,6 +98,7 @@ Coordinator::Coordinator(CoordinatorOptions options) : impl_(std::make_unique<Im
     }
     JobState& job = s.jobs.add(s.rebuild_job(row));
     s.save_decisions(job);
+    s.fold_splats(job);  // (its stored splats, a chunk at a time)
     passes += job.done_units();
     if (!is_terminal(job.phase()) && job.complete()) {  // its last result landed before a crash
       s.complete_job(job);

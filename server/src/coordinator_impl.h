@@ -114,8 +114,8 @@ struct Coordinator::Impl {
   Status check_splat_result(const JobState& job, size_t unit, const SplatResult& result);
   /// Appends a checked result for `unit` (now committing) to the group commit; its ticket. Once
   /// durable, result_committed adds it to the job.
-  uint64_t commit_result(JobState& job, size_t unit, uint64_t worker, const UnitUpload& upload, std::string_view bytes)
-      TESSERA_REQUIRES(mu);
+  uint64_t commit_result(JobState& job, size_t unit, uint64_t worker, const UnitUpload& upload,
+                         const std::shared_ptr<const UploadBytes>& bytes) TESSERA_REQUIRES(mu);
   /// Once durable (a group-commit callback): the result enters its job, which may then be done;
   /// `durable` false: the unit is open again.
   void result_committed(bool durable, uint64_t job, size_t unit, uint64_t worker, const UnitUpload& upload, size_t bytes)
@@ -123,6 +123,9 @@ struct Coordinator::Impl {
   /// A second result for a done unit is dropped, and compared with the first when its digest was
   /// kept (a mismatch is counted and logged as an error).
   void check_duplicate(JobState& job, size_t unit, uint64_t worker, const Sha256Digest& digest) TESSERA_REQUIRES(mu);
+  /// Folds the job's ready splats on the background queue, a chunk per hold of `mu`; completes the
+  /// job once its last are in.
+  void fold_splats(JobState& job) TESSERA_REQUIRES(mu);
   /// Appends the tile's checkpoint once `min_new` more passes are in its film (encoded by the
   /// writer, not under `mu`).
   void checkpoint_tile(JobState& job, uint32_t tile, uint32_t min_new) TESSERA_REQUIRES(mu);

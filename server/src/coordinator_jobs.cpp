@@ -404,6 +404,7 @@ Status Coordinator::retry_job(uint64_t id) {
     return not_ended(now->phase());  // (retried by another request meanwhile)
   JobState& fresh = s.jobs.replace(std::move(job));
   s.save_decisions(fresh);
+  s.fold_splats(fresh);
   const uint64_t ticket = s.change_phase(fresh, JobPhase::Queued);
   lock.unlock();
   return s.durable(ticket);

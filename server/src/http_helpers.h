@@ -50,6 +50,10 @@ class Router {
   explicit Router(httplib::Server& http) : http_(http) {}
   void get(const char* pattern, httplib::Server::Handler h) { add("GET", pattern), http_.Get(pattern, std::move(h)); }
   void post(const char* pattern, httplib::Server::Handler h) { add("POST", pattern), http_.Post(pattern, std::move(h)); }
+  /// A POST whose handler reads the body itself (as it arrives).
+  void post(const char* pattern, httplib::Server::HandlerWithContentReader h) {
+    add("POST", pattern), http_.Post(pattern, std::move(h));
+  }
   void patch(const char* pattern, httplib::Server::Handler h) { add("PATCH", pattern), http_.Patch(pattern, std::move(h)); }
   void del(const char* pattern, httplib::Server::Handler h) { add("DELETE", pattern), http_.Delete(pattern, std::move(h)); }
   void add(const std::vector<Route>& more) { routes_.insert(routes_.end(), more.begin(), more.end()); }

@@ -51,6 +51,7 @@ JobState::JobState(uint64_t id, JobPlan plan, std::string name, int priority, do
   accepted_from_.assign(num_units(), 0);
   folded_.assign(num_tiles(), 0);
   tile_committing_.assign(num_tiles(), 0);
+  seq_.films().fold_later();
 }
 
 std::optional<Lease::Guide> JobState::lease_guide(size_t unit) const {

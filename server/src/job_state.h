@@ -72,7 +72,14 @@ class JobState {
   /// Samples done of the samples the job will have (1 for a job with none).
   double progress() const { return total_samples() ? double(done_samples()) / double(total_samples()) : 1.0; }
   size_t planned_units() const { return seq_.planned_units(); }
-  bool complete() const { return seq_.complete(); }
+  /// Every planned unit is done and its splats folded into the film.
+  bool complete() const { return seq_.complete() && !seq_.films().splats_held(); }
+
+  // A Paths unit's splats are folded a chunk at a time (fold_splats), each chunk under the
+  // coordinator's lock, never a whole image-wide result at once.
+  bool splats_ready() const { return seq_.films().splats_ready(); }
+  size_t fold_splats(size_t max_splats) { return seq_.films().fold_splats(max_splats); }
+  bool folding = false;  // a fold task is queued or running
 
   // Target error: the sequencer stops at a barrier whose estimate is at the target; the decision
   // depends on the film of the passes before it alone, so it is the same however the tiles were

@@ -1,5 +1,6 @@
 // Workers: registration, lease long polls, heartbeats, results, failures, sign-off and draining.
 #include "http_helpers.h"
+#include "upload_spool.h"
 
 namespace tessera::server {
 
@@ -46,13 +47,18 @@ void add_worker_routes(Router& r, Coordinator& c) {
     if (!drop.ok()) return send_error(res, drop.status);
     send_json(res, 200, json{{"drop", drop.value}});
   });
-  r.post(R"(/api/v1/workers/(\d+)/results)", [&c](const httplib::Request& req, httplib::Response& res) {
-    uint64_t id;
-    if (!parse_id(req, 1, id, res)) return;
-    // (Compact, as the lease's answer: a worker's hot path, read by programs.)
-    send(res, c.upload_result(id, uint64_t(query_number(req, "lease", 0)), req.body, query_number(req, "next", 0) != 0),
-         200, /*compact=*/true);
-  });
+  r.post(R"(/api/v1/workers/(\d+)/results)",
+         [&c](const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& reader) {
+           uint64_t id;
+           if (!parse_id(req, 1, id, res)) return;
+           Result<std::shared_ptr<const UploadBytes>> body = read_upload(reader, c.spool_dir());
+           if (!body.ok()) return send_error(res, body.status);
+           // (Compact, as the lease's answer: a worker's hot path, read by programs.)
+           send(res,
+                c.upload_result(id, uint64_t(query_number(req, "lease", 0)), std::move(body.value),
+                                query_number(req, "next", 0) != 0),
+                200, /*compact=*/true);
+         });
   r.post(R"(/api/v1/workers/(\d+)/leases/(\d+)/fail)", [&c](const httplib::Request& req, httplib::Response& res) {
     uint64_t id, lease;
     json body;

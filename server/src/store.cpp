@@ -79,8 +79,9 @@ class Stmt {
   Stmt& bind(const std::string& v) {
     return check(sqlite3_bind_text(stmt_, ++n_, v.data(), int(v.size()), SQLITE_TRANSIENT));
   }
-  Stmt& blob(const std::string& v) {
-    return check(sqlite3_bind_blob64(stmt_, ++n_, v.data(), v.size(), SQLITE_TRANSIENT));
+  Stmt& blob(std::string_view v) {
+    // (An empty view may have no pointer, which SQLite would store as NULL, not as no bytes.)
+    return check(sqlite3_bind_blob64(stmt_, ++n_, v.empty() ? "" : v.data(), v.size(), SQLITE_TRANSIENT));
   }
   /// True while there is a row; throws on errors (a constraint violation returns false with
   /// constraint() set).
@@ -258,7 +259,7 @@ uint64_t Store::last_lease_seq() {
   return uint64_t(st.i(0));
 }
 
-bool Store::add_result(uint64_t job, uint32_t tile, uint32_t pass, uint64_t worker, const std::string& data,
+bool Store::add_result(uint64_t job, uint32_t tile, uint32_t pass, uint64_t worker, std::string_view data,
                        double now) {
   WriteLock lock(write_mu_);
   // ack_seq: the newest lease at acknowledgement; any lease for this pass with a larger sequence

@@ -10,6 +10,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <numeric>
+#include <random>
 #include <set>
 
 namespace tessera::test {
@@ -109,6 +111,32 @@ TEST(PassSequencer, ImageWideResultsAreSummedInUnitOrder) {
       for (int c = 0; c < 3; ++c)
         differing += shuffled.image.at(x, y, c) != float(sum[size_t(y * w.width() + x) * 3 + size_t(c)] / 3.0);
   EXPECT_EQ(differing, 0) << "pixel = splat sum / light paths per pixel (3)";
+}
+
+TEST(PassSequencer, SplatsFoldedAChunkAtATimeSumToTheSameBits) {
+  // A coordinator folds a unit's splats a few thousand at a time, taking its lock for each chunk:
+  // the sums are those of folding each unit at once, whatever the chunk size.
+  PassProgram program;
+  program.spp = 3;
+  program.paths_per_unit = 29;
+  program.passes = {PassSpec{UnitKind::Paths, 0, 2}, PassSpec{UnitKind::Paths, 2, 1}};
+  const Outcome whole = run_shuffled(program, 8, kSeed, 3);
+  for (size_t chunk : {size_t(1), size_t(7), size_t(100)}) {
+    PassSequencer seq = toy_sequencer(program, 8);
+    seq.films().fold_later();
+    ToyUnits units(kSeed);
+    std::vector<size_t> order(seq.num_units());
+    std::iota(order.begin(), order.end(), size_t(0));
+    std::shuffle(order.begin(), order.end(), std::mt19937(uint32_t(chunk)));
+    for (size_t u : order) {
+      render_and_add(seq, units, u);
+      if (seq.films().splats_ready()) (void)seq.films().fold_splats(chunk);  // (one chunk per result)
+    }
+    EXPECT_TRUE(seq.films().splats_held()) << "chunk " << chunk << ": some are left to fold";
+    while (seq.films().splats_ready()) (void)seq.films().fold_splats(chunk);
+    EXPECT_FALSE(seq.films().splats_held());
+    EXPECT_TRUE(outcome(seq).sums == whole.sums) << "chunk " << chunk;
+  }
 }
 
 TEST(PassSequencer, AnArtifactWaitsForItsBarrierAndItsStore) {

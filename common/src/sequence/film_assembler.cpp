@@ -85,24 +85,36 @@ void FilmAssembler::add_splat(uint32_t pass, uint32_t index, SplatSums&& result)
     return;
   }
   held_splats_.emplace(std::pair{pass, index}, std::move(result));
-  for (auto it = held_splats_.find(next_splat_); it != held_splats_.end(); it = held_splats_.find(next_splat_)) {
+  if (!fold_later_) (void)fold_splats(std::numeric_limits<size_t>::max());
+}
+
+size_t FilmAssembler::fold_splats(size_t max_splats) {
+  size_t folded = 0;
+  for (auto it = held_splats_.find(next_splat_); it != held_splats_.end() && folded < max_splats;
+       it = held_splats_.find(next_splat_)) {
     const auto [p, i] = it->first;
     const int f = program_.passes[p].film;
     const SplatSums& s = it->second;
+    const size_t end = std::min(s.pixel.size(), next_splat_entry_ + (max_splats - folded));
     if (f != kNoFilm && !films_.empty()) {
       std::vector<double>& layer = splats_[size_t(f)];
       if (layer.empty()) layer.assign(size_t(window_.area()) * 3, 0.0);
-      for (size_t k = 0; k < s.pixel.size(); ++k)
+      for (size_t k = next_splat_entry_; k < end; ++k)
         for (int c = 0; c < 3; ++c) layer[size_t(s.pixel[k]) * 3 + size_t(c)] += s.value[k][size_t(c)];
-      splat_paths_[size_t(f)] += unit_paths(p, i);
     }
-    counters_ += s.counters;
+    folded += end - next_splat_entry_;
+    next_splat_entry_ = end;
     ++changes_;
+    if (end < s.pixel.size()) break;  // (the rest of this unit next time)
+    if (f != kNoFilm && !films_.empty()) splat_paths_[size_t(f)] += unit_paths(p, i);
+    counters_ += s.counters;
     held_splats_.erase(it);
+    next_splat_entry_ = 0;
     next_splat_ = unit_paths(p, i + 1) > 0 ? std::pair{p, i + 1} : std::pair{p + 1, 0u};
     while (next_splat_.first < program_.passes.size() && program_.passes[next_splat_.first].kind != UnitKind::Paths)
       ++next_splat_.first;
   }
+  return folded;
 }
 
 NoiseEstimate FilmAssembler::noise() const {

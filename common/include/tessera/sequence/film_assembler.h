@@ -36,8 +36,19 @@ class FilmAssembler {
 
   /// Tile `tile`'s result of Tile pass `pass` (each once).
   void add_tile(uint32_t pass, uint32_t tile, FilmTile&& result);
-  /// Unit `index` of Paths pass `pass` (each once).
+  /// Unit `index` of Paths pass `pass` (each once). Folded at once, or with fold_later() held for
+  /// fold_splats().
   void add_splat(uint32_t pass, uint32_t index, SplatSums&& result);
+  /// Splats are folded only by fold_splats(): a coordinator folds a unit a chunk at a time, taking
+  /// its lock for each chunk rather than for a whole image-wide result.
+  void fold_later() { fold_later_ = true; }
+  /// Folds up to `max_splats` splats of the units next in order (a unit may be left part-folded,
+  /// its rest folded next time); how many it folded. splats_ready() says whether more are.
+  size_t fold_splats(size_t max_splats);
+  /// Splats held, ready to fold or waiting for an earlier unit.
+  bool splats_held() const { return !held_splats_.empty(); }
+  /// Whether the next unit in order is held (fold_splats() has work).
+  bool splats_ready() const { return held_splats_.count(next_splat_) > 0; }
 
   /// The tile's next pass to enter its film (passes before it are in; the number of passes once
   /// every one is).
@@ -101,6 +112,8 @@ class FilmAssembler {
   std::map<std::pair<uint32_t, uint32_t>, FilmTile> held_tiles_;    // by (pass, tile)
   std::map<std::pair<uint32_t, uint32_t>, SplatSums> held_splats_;  // by (pass, unit)
   std::pair<uint32_t, uint32_t> next_splat_;                         // (pass, unit) folded next
+  size_t next_splat_entry_ = 0;                                      // of that unit, folded so far
+  bool fold_later_ = false;
   RenderCounters counters_;
   uint64_t changes_ = 0;
   bool released_ = false;

@@ -8,6 +8,7 @@
 #pragma once
 
 #include "tessera/farm/bundle.h"
+#include "tessera/farm/mapped_file.h"
 #include "tessera/farm/farm_status.h"
 #include "tessera/farm/job_status.h"
 #include "tessera/farm/protocol.h"
@@ -77,6 +78,14 @@ struct StoredFile {
   uint64_t size = 0;
 };
 
+/// An upload's bytes: in memory, or (a large one) spooled to a file as it arrived and mapped, never
+/// read whole into the heap. Shared by whatever still needs them (the group commit's writer).
+struct UploadBytes {
+  std::string memory;
+  std::shared_ptr<const MappedFile> file;
+  std::string_view view() const { return file ? file->bytes() : std::string_view(memory); }
+};
+
 /// What an upload may weigh, and what it is (named in a 413's message).
 struct BodyLimit {
   uint64_t bytes = 0;
@@ -135,7 +144,13 @@ class Coordinator {
   /// dropped. Valid without a live lease too (a worker finishing across a coordinator restart).
   /// Answered once durable. With `next`, the answer also carries the worker's next lease (none
   /// when there is no work it may take now), logged in the same commit as the result.
-  Result<ResultAck> upload_result(uint64_t worker, uint64_t lease, std::string_view bytes, bool next = false);
+  Result<ResultAck> upload_result(uint64_t worker, uint64_t lease, std::shared_ptr<const UploadBytes> bytes,
+                                  bool next = false);
+  Result<ResultAck> upload_result(uint64_t worker, uint64_t lease, std::string_view bytes, bool next = false) {
+    return upload_result(worker, lease, std::make_shared<const UploadBytes>(UploadBytes{std::string(bytes), nullptr}), next);
+  }
+  /// Where uploads are spooled while they arrive (data-dir/tmp).
+  std::string spool_dir() const;
   /// The worker could not render the lease (`reason`, at most 2000 characters kept).
   Status fail_lease(uint64_t worker, uint64_t lease, const std::string& reason);
   Status sign_off(uint64_t worker);

@@ -17,6 +17,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -98,7 +99,7 @@ class Store {
   /// The highest worker id registered so far (0 if none).
   uint64_t last_worker_id();
   /// Commits an acknowledged result. False if (job, tile, pass) already had one (a duplicate).
-  bool add_result(uint64_t job, uint32_t tile, uint32_t pass, uint64_t worker, const std::string& data,
+  bool add_result(uint64_t job, uint32_t tile, uint32_t pass, uint64_t worker, std::string_view data,
                   double now);
   /// Stores a tile's checkpoint (its sums over passes 0..passes-1, tile_result.h bytes) and drops
   /// the bytes of the results of passes from..passes-1, which it now holds; their rows stay.
