@@ -2,7 +2,8 @@
 
 #include "tessera/farm/tile_result.h"
 
-#include <xxhash.h>
+#include "result_bytes.h"
+
 #include <zstd.h>
 
 #include <algorithm>
@@ -13,60 +14,24 @@
 namespace tessera {
 namespace {
 
+using result_bytes::checksum;
+using result_bytes::put;
+using result_bytes::Reader;
+
 constexpr char kMagic[4] = {'T', 'S', 'P', 'L'};
 constexpr uint32_t kVersion = 1;
 constexpr size_t kHeaderBytes = 4 + 4 + 8 + 4 + 4 + 8 + 8 + 16 + 5 * 8 + 8;
 constexpr size_t kSplatBytes = 4 + 3 * 8;
-constexpr size_t kDigestBytes = 16;
+constexpr size_t kDigestBytes = result_bytes::kChecksumBytes;
 
-std::array<char, kDigestBytes> checksum(std::string_view bytes) {
-  XXH128_canonical_t c;
-  XXH128_canonicalFromHash(&c, XXH3_128bits(bytes.data(), bytes.size()));
-  std::array<char, kDigestBytes> out;
-  std::memcpy(out.data(), c.digest, out.size());
-  return out;
-}
-
-template <class T>
-void put(std::string& out, const T& v) {
-  out.append(reinterpret_cast<const char*>(&v), sizeof(T));
-}
-
-struct Reader {
-  std::string_view in;
-  size_t pos = 0;
-  template <class T>
-  T get() {
-    T v;
-    std::memcpy(&v, in.data() + pos, sizeof(T));
-    pos += sizeof(T);
-    return v;
-  }
-};
-
-// The uncompressed bytes of `bytes` into `raw` (or a view of `bytes` when stored as they are),
+// The uncompressed bytes of `bytes` (into `raw`, or a view of `bytes` when stored as they are),
 // within `max_size`.
 bool uncompressed(std::string_view bytes, std::string& raw, std::string_view& view, uint64_t max_size, std::string& error) {
   if (bytes.size() >= 4 && std::memcmp(bytes.data(), kMagic, 4) == 0) {
     view = bytes;
     return true;
   }
-  unsigned long long size = 0;
-  for (size_t pos = 0; pos < bytes.size();) {
-    const unsigned long long n = ZSTD_getFrameContentSize(bytes.data() + pos, bytes.size() - pos);
-    const size_t frame = ZSTD_findFrameCompressedSize(bytes.data() + pos, bytes.size() - pos);
-    if (n == ZSTD_CONTENTSIZE_ERROR || n == ZSTD_CONTENTSIZE_UNKNOWN || ZSTD_isError(frame) || (size += n) > max_size) {
-      error = "splat result: not zstd frames of known sizes within " + std::to_string(max_size) + " bytes";
-      return false;
-    }
-    pos += frame;
-  }
-  raw.resize(size_t(size));
-  const size_t n = ZSTD_decompress(raw.data(), raw.size(), bytes.data(), bytes.size());
-  if (ZSTD_isError(n) || n != raw.size()) {
-    error = "splat result: corrupt or truncated";
-    return false;
-  }
+  if (!result_bytes::decompress(bytes, max_size, raw, error, "splat result")) return false;
   view = raw;
   return true;
 }
@@ -75,7 +40,7 @@ bool uncompressed(std::string_view bytes, std::string& raw, std::string_view& vi
 
 uint64_t max_splat_result_bytes(uint64_t paths, uint64_t max_record_bytes) {
   const uint64_t raw = kHeaderBytes + 8 + paths * kMaxSplatsPerPath * kSplatBytes + 8 + max_record_bytes + kDigestBytes;
-  return ZSTD_compressBound(size_t(raw)) + raw / 64 + (uint64_t(64) << 10);
+  return result_bytes::max_compressed_bytes(raw);
 }
 
 bool is_splat_result(std::string_view bytes) {
@@ -115,11 +80,7 @@ std::string encode_splat_result(const SplatResult& r, int level) {
   raw.append(r.records);
   const auto digest = checksum(raw);
   raw.append(digest.data(), digest.size());
-  if (level == kUncompressed) return raw;
-  std::string out(ZSTD_compressBound(raw.size()), '\0');
-  const size_t n = ZSTD_compress(out.data(), out.size(), raw.data(), raw.size(), level);
-  out.resize(ZSTD_isError(n) ? 0 : n);  // compressBound makes an error impossible
-  return out;
+  return result_bytes::compress(std::move(raw), level);
 }
 
 namespace {

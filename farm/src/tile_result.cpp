@@ -2,8 +2,8 @@
 
 #include "tessera/farm/sha256.h"
 
-#include <xxhash.h>
-#include <zstd.h>
+#include "result_bytes.h"
+
 
 #include <array>
 #include <bit>
@@ -12,6 +12,10 @@
 
 namespace tessera {
 namespace {
+
+using result_bytes::checksum;
+using result_bytes::put;
+using result_bytes::Reader;
 
 static_assert(std::endian::native == std::endian::little, "the tile format is little-endian");
 constexpr char kMagic[4] = {'T', 'S', 'T', 'R'};
@@ -34,39 +38,12 @@ static_assert(sizeof(AovSums) == kAovBytes && std::is_trivially_copyable_v<AovSu
 
 size_t digest_bytes(uint32_t version) { return version == kVersionSha256 ? sizeof(Sha256Digest) : kTileResultDigestBytes; }
 
-// The checksum of `bytes` as the format stores it (XXH3-128, big-endian canonical form).
-std::array<char, kTileResultDigestBytes> checksum(std::string_view bytes) {
-  XXH128_canonical_t c;
-  XXH128_canonicalFromHash(&c, XXH3_128bits(bytes.data(), bytes.size()));
-  std::array<char, kTileResultDigestBytes> out;
-  std::memcpy(out.data(), c.digest, out.size());
-  return out;
-}
-
-template <class T>
-void put(std::string& out, const T& v) {
-  out.append(reinterpret_cast<const char*>(&v), sizeof(T));
-}
-
-struct Reader {
-  std::string_view in;
-  size_t pos = 0;
-  template <class T>
-  T get() {
-    T v;
-    std::memcpy(&v, in.data() + pos, sizeof(T));
-    pos += sizeof(T);
-    return v;
-  }
-};
-
 }  // namespace
 
 uint64_t max_tile_result_bytes(const TileRect& rect, bool aovs, bool training) {
   const uint64_t raw = kHeaderBytes + uint64_t(rect.area()) * (kPixelBytes + (aovs ? kAovBytes : 0)) + 16 +
                        (training ? kMaxTrainingBytes : 0) + kMaxDigestBytes;
-  // Frames compressed apart (concatenated) cost a little more than one: a generous margin.
-  return ZSTD_compressBound(size_t(raw)) + raw / 64 + (uint64_t(64) << 10);
+  return result_bytes::max_compressed_bytes(raw);
 }
 
 std::string encode_tile_result(const TileResult& r, int level) {
@@ -91,52 +68,16 @@ std::string encode_tile_result(const TileResult& r, int level) {
   raw.append(reinterpret_cast<const char*>(r.film.aovs().data()), r.film.aovs().size() * kAovBytes);
   const auto digest = checksum(raw);
   raw.append(digest.data(), digest.size());
-  if (level == kUncompressed) return raw;
-
-  std::string out(ZSTD_compressBound(raw.size()), '\0');
-  size_t n = ZSTD_compress(out.data(), out.size(), raw.data(), raw.size(), level);
-  out.resize(ZSTD_isError(n) ? 0 : n);  // compressBound makes an error impossible
-  return out;
+  return result_bytes::compress(std::move(raw), level);
 }
 
 namespace {
 
-// The uncompressed size of concatenated zstd frames (they decode as one: an encoder may compress
-// the parts separately), or an error if a frame is malformed, does not state its size, or the total
-// exceeds what `max_pixels` allows.
-bool decompressed_size(std::string_view bytes, unsigned long long& size, std::string& error, int64_t max_pixels) {
-  const unsigned long long max_size =
-      kHeaderBytes + kMaxDigestBytes + (unsigned long long)max_pixels * (kPixelBytes + kAovBytes) + 16 + kMaxTrainingBytes;
-  size = 0;
-  for (size_t pos = 0; pos < bytes.size();) {
-    const unsigned long long n = ZSTD_getFrameContentSize(bytes.data() + pos, bytes.size() - pos);
-    const size_t frame = ZSTD_findFrameCompressedSize(bytes.data() + pos, bytes.size() - pos);
-    if (n == ZSTD_CONTENTSIZE_ERROR || n == ZSTD_CONTENTSIZE_UNKNOWN || ZSTD_isError(frame)) {
-      error = "tile result: not zstd frames with known sizes";
-      return false;
-    }
-    size += n;
-    if (size > max_size) break;
-    pos += frame;
-  }
-  if (size < kHeaderBytes + kTileResultDigestBytes || size > max_size) {
-    error = "tile result: implausible size " + std::to_string(size) + " bytes";
-    return false;
-  }
-  return true;
-}
-
-// The uncompressed bytes of a compressed result, into `raw`.
+// The uncompressed bytes of a compressed result, into `raw`, within what `max_pixels` allows.
 bool decompress(std::string_view bytes, std::string& raw, std::string& error, int64_t max_pixels) {
-  unsigned long long size = 0;
-  if (!decompressed_size(bytes, size, error, max_pixels)) return false;
-  raw.resize(size_t(size));
-  size_t n = ZSTD_decompress(raw.data(), raw.size(), bytes.data(), bytes.size());
-  if (ZSTD_isError(n) || n != raw.size()) {
-    error = std::string("tile result: corrupt or truncated: ") + (ZSTD_isError(n) ? ZSTD_getErrorName(n) : "short");
-    return false;
-  }
-  return true;
+  const uint64_t max_size =
+      kHeaderBytes + kMaxDigestBytes + uint64_t(max_pixels) * (kPixelBytes + kAovBytes) + 16 + kMaxTrainingBytes;
+  return result_bytes::decompress(bytes, max_size, raw, error, "tile result");
 }
 
 // Whether the bytes' trailing checksum (of the version's kind) matches what precedes it.
