@@ -116,7 +116,7 @@ void Loop::send(Sim& s, client::RequestSpec r) {
   if (s.fd < 0 || (::connect(s.fd, reinterpret_cast<sockaddr*>(&addr_), sizeof(addr_)) != 0 && errno != EINPROGRESS)) {
     if (s.fd >= 0) ::close(s.fd);
     s.fd = -1;
-    return complete(s, client::HttpReply{0, "", std::string("connect: ") + std::strerror(errno), {}});
+    return complete(s, client::HttpReply{0, "", std::string("connect: ") + std::strerror(errno), "", {}});
   }
   epoll_event ev{};
   ev.events = EPOLLOUT;
@@ -127,7 +127,7 @@ void Loop::send(Sim& s, client::RequestSpec r) {
 void Loop::on_ready(Sim& s, uint32_t events) {
   if (s.sent < s.out.size()) {  // writing the request
     const ssize_t n = ::send(s.fd, s.out.data() + s.sent, s.out.size() - s.sent, MSG_NOSIGNAL);
-    if (n < 0 && errno != EAGAIN) return complete(s, client::HttpReply{0, "", std::strerror(errno), {}});
+    if (n < 0 && errno != EAGAIN) return complete(s, client::HttpReply{0, "", std::strerror(errno), "", {}});
     if (n > 0) s.sent += size_t(n);
     if (s.sent == s.out.size()) {
       epoll_event ev{};
@@ -145,7 +145,7 @@ void Loop::on_ready(Sim& s, uint32_t events) {
       continue;
     }
     if (n < 0 && errno == EAGAIN && !(events & (EPOLLHUP | EPOLLERR))) return;
-    return complete(s, n == 0 ? parse_reply(s.in) : client::HttpReply{0, "", std::strerror(errno), {}});
+    return complete(s, n == 0 ? parse_reply(s.in) : client::HttpReply{0, "", std::strerror(errno), "", {}});
   }
 }
 

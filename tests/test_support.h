@@ -29,6 +29,9 @@ struct TempDir {
     static int counter = 0;
     path = std::filesystem::temp_directory_path() /
            ("tessera_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+    // (A test that crashed left its folder; a later process may reuse its pid.)
+    std::error_code ec;
+    std::filesystem::remove_all(path, ec);
     std::filesystem::create_directories(path);
   }
   ~TempDir() {

@@ -3,6 +3,7 @@
 #include "tessera/cli/command_line.h"
 #include "tessera/cli/commands.h"
 
+#include <csignal>
 #include <iostream>
 
 namespace tessera::cli {
@@ -27,6 +28,9 @@ void add_connection_options(CLI::App& command, ConnectionOptions& c) {
 }
 
 int main_entry(int argc, char** argv) {
+  // A coordinator refusing an upload closes the connection without reading the rest: the write
+  // then fails with EPIPE and the answer (a 413 naming the limit) is printed, not a silent death.
+  ::signal(SIGPIPE, SIG_IGN);
   CLI::App app{"Tessera: a physically based path tracer for Mitsuba scenes"};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("tessera ") + TESSERA_VERSION);

@@ -26,4 +26,14 @@ bool connect(const ConnectionOptions& c, const char* who, client::FarmApi& out) 
   return true;
 }
 
+std::string farm_error(const client::HttpReply& reply, const ConnectionOptions& c) {
+  std::string out = reply.describe();
+  if (reply.status != 401) return out;
+  const char* env = std::getenv("TESSERA_CLIENT_TOKEN");
+  if (!c.token_file.empty()) out += "; the coordinator refused the client token from --token-file " + c.token_file;
+  else if (env && *env) out += "; the coordinator refused the client token in $TESSERA_CLIENT_TOKEN";
+  else out += "; the coordinator wants a client token and none was sent";
+  return out + " (give its --client-token: set TESSERA_CLIENT_TOKEN=TOKEN or pass --token-file FILE)";
+}
+
 }  // namespace tessera::cli

@@ -12,4 +12,8 @@ namespace tessera::cli {
 /// not one.
 bool connect(const ConnectionOptions& connection, const char* who, client::FarmApi& out);
 
+/// A failed request in words: the answer or the URL that did not answer, and for a 401 which
+/// client token was sent (from --token-file or $TESSERA_CLIENT_TOKEN, or none) and how to give one.
+std::string farm_error(const client::HttpReply& reply, const ConnectionOptions& connection);
+
 }  // namespace tessera::cli

@@ -17,7 +17,7 @@ int run_jobs(const JobsOptions& o) {
   client::HttpReply r = api.jobs();
   json j = r.json();
   if (!r.ok() || !j.is_object()) {
-    std::cerr << "tessera jobs: " << r.describe() << "\n";
+    std::cerr << "tessera jobs: " << farm_error(r, o.connection) << "\n";
     return 1;
   }
   std::printf("%6s  %-10s %6s %9s %11s %6s  %s\n", "ID", "STATE", "PRIO", "PROGRESS", "SIZE", "SPP", "NAME");
@@ -34,7 +34,7 @@ int run_cancel(const JobsOptions& o) {
   if (!connect(o.connection, "tessera cancel", api)) return 2;
   client::HttpReply r = api.cancel_job(o.cancel_id);
   if (!r.ok()) {
-    std::cerr << "tessera cancel: " << r.describe() << "\n";
+    std::cerr << "tessera cancel: " << farm_error(r, o.connection) << "\n";
     return 1;
   }
   std::cerr << "job " << o.cancel_id << " cancelled\n";

@@ -10,10 +10,25 @@ using nlohmann::json;
 
 namespace {
 
-HttpReply reply_of(const httplib::Result& r) {
+// What went wrong with no answer, in words (httplib's names, such as "Connection", say little).
+std::string transport_error(httplib::Error e) {
+  switch (e) {
+    case httplib::Error::Connection: return "connection refused or host unreachable";
+    case httplib::Error::ConnectionTimeout: return "connection timed out";
+    case httplib::Error::Read: return "the connection broke or timed out before the answer";
+    case httplib::Error::Write: return "the connection broke while sending";
+    case httplib::Error::SSLConnection: return "TLS handshake failed";
+    case httplib::Error::SSLServerVerification: return "its certificate did not verify (--ca-file)";
+    case httplib::Error::SSLLoadingCerts: return "cannot load the CA certificates";
+    default: return httplib::to_string(e);
+  }
+}
+
+HttpReply reply_of(const std::string& url, const httplib::Result& r) {
   HttpReply out;
+  out.url = url;
   if (!r) {
-    out.transport = httplib::to_string(r.error());
+    out.transport = transport_error(r.error());
     return out;
   }
   out.status = r->status;
@@ -56,7 +71,7 @@ nlohmann::json HttpReply::json() const {
 }
 
 std::string HttpReply::describe() const {
-  if (status == 0) return "no answer from the server (" + transport + ")";
+  if (status == 0) return url.empty() ? transport : "no answer from " + url + " (" + transport + ")";
   nlohmann::json j = json();
   std::string s = "HTTP " + std::to_string(status);
   if (j.is_object() && j.contains("error") && j["error"].is_string()) {
@@ -98,7 +113,7 @@ bool FarmClient::valid(std::string* why) const {
 }
 
 HttpReply FarmClient::get(const std::string& path, double timeout) const {
-  return reply_of(make_client({host_, port_, tls_, token_, ca_file_}, timeout)->Get(path.c_str()));
+  return reply_of(url_, make_client({host_, port_, tls_, token_, ca_file_}, timeout)->Get(path.c_str()));
 }
 
 HttpReply FarmClient::get_to_file(const std::string& path, const std::string& file, double timeout) const {
@@ -117,31 +132,32 @@ HttpReply FarmClient::get_to_file(const std::string& path, const std::string& fi
         if (status < 200 || status >= 300) return error_body.append(data, n).size() < (size_t(1) << 20);
         return bool(out.write(data, std::streamsize(n)));
       });
-  HttpReply reply = reply_of(r);
+  HttpReply reply = reply_of(url_, r);
   reply.body = std::move(error_body);
   out.close();
   if (r && reply.ok() && !out) {
     reply.status = 0;
+    reply.url.clear();  // (the server answered; the failure is here)
     reply.transport = "cannot write " + file;
   }
   return reply;
 }
 
 HttpReply FarmClient::del(const std::string& path, const json& body, double timeout) const {
-  return reply_of(make_client({host_, port_, tls_, token_, ca_file_}, timeout)->Delete(path.c_str(), body.dump(), "application/json"));
+  return reply_of(url_, make_client({host_, port_, tls_, token_, ca_file_}, timeout)->Delete(path.c_str(), body.dump(), "application/json"));
 }
 
 HttpReply FarmClient::post_json(const std::string& path, const json& body, double timeout) const {
-  return reply_of(make_client({host_, port_, tls_, token_, ca_file_}, timeout)->Post(path.c_str(), body.dump(), "application/json"));
+  return reply_of(url_, make_client({host_, port_, tls_, token_, ca_file_}, timeout)->Post(path.c_str(), body.dump(), "application/json"));
 }
 
 HttpReply FarmClient::patch_json(const std::string& path, const json& body, double timeout) const {
-  return reply_of(make_client({host_, port_, tls_, token_, ca_file_}, timeout)->Patch(path.c_str(), body.dump(), "application/json"));
+  return reply_of(url_, make_client({host_, port_, tls_, token_, ca_file_}, timeout)->Patch(path.c_str(), body.dump(), "application/json"));
 }
 
 HttpReply FarmClient::post_bytes(const std::string& path, const std::string& bytes, const std::string& type,
                                  double timeout) const {
-  return reply_of(make_client({host_, port_, tls_, token_, ca_file_}, timeout)->Post(path.c_str(), bytes, type.c_str()));
+  return reply_of(url_, make_client({host_, port_, tls_, token_, ca_file_}, timeout)->Post(path.c_str(), bytes, type.c_str()));
 }
 
 HttpReply FarmClient::post_settings_and_bundle(const std::string& path, const json& settings, const std::string& bundle,
@@ -150,7 +166,7 @@ HttpReply FarmClient::post_settings_and_bundle(const std::string& path, const js
       {"settings", settings.dump(), "settings.json", "application/json"},
       {"bundle", bundle, "scene.tar.gz", "application/gzip"},
   };
-  return reply_of(make_client({host_, port_, tls_, token_, ca_file_}, timeout)->Post(path.c_str(), items));
+  return reply_of(url_, make_client({host_, port_, tls_, token_, ca_file_}, timeout)->Post(path.c_str(), items));
 }
 
 }  // namespace tessera::client

@@ -3,6 +3,7 @@
 #include "tessera/farm/bundle.h"
 #include "tessera/farm/program_json.h"
 #include "tessera/guiding/tree_io.h"
+#include "tessera/render/aov.h"
 #include "tessera/render/light_sampler.h"
 #include "tessera/sequence/renderer.h"
 #include "tessera/scene/error.h"
@@ -27,6 +28,7 @@ LoadedJobScene load_job_scene(const std::string& bundle_dir, const std::string& 
   load_options.height = settings.height;
   load_options.spp = settings.spp;
   load_options.integrator = settings.integrator;
+  load_options.allow_unsupported = settings.allow_unsupported;
   if (confine) load_options.root_dir = bundle_dir;
   out.loaded = load_scene(out.desc, load_options);
   if (!settings.light_selection.empty()) {
@@ -73,6 +75,17 @@ PassProgram job_program(const JobPlan& plan) {
   return plan.program.passes.empty() ? path_program(path_options(plan)) : plan.program;
 }
 
+void keep_job_exr_layers(const JobSettings& settings, std::vector<ImageLayer>& layers) {
+  if (settings.aovs.empty()) {
+    if (!settings.denoise) layers.clear();
+    return;
+  }
+  const std::vector<AovLayer> wanted = parse_aov_layers(settings.aovs).value_or(std::vector<AovLayer>{});
+  std::erase_if(layers, [&](const ImageLayer& l) {
+    return std::none_of(wanted.begin(), wanted.end(), [&](AovLayer a) { return l.name == aov_layer_name(a); });
+  });
+}
+
 void begin_tile_result(const Lease& lease, TileResult& out) {
   out.job_id = lease.job_id;
   out.tile = lease.tile;
@@ -98,9 +111,9 @@ TileResult render_lease(const Scene& scene, const Lease& lease, const SpatialTre
   if (lease.guide && lease.guide->train) recorder = make_recorder(*guide);
   std::optional<PathGuide> path_guide;
   if (lease.guide) path_guide = PathGuide{guide, recorder ? &*recorder : nullptr, lease.guide->iteration > 0, lease.guide->train};
-  // A denoised job's units also sum the AOVs the denoiser reads.
+  // A denoised job's units, or one's with AOV layers, also sum the AOVs.
   render_tile(scene, lease.rect, samples, lease.settings.seed, result.film, path_guide ? &*path_guide : nullptr,
-              lease.settings.denoise);
+              lease.settings.sums_aovs());
   if (recorder) result.training = write_records(*recorder);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return result;

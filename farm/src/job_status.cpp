@@ -49,6 +49,7 @@ json to_json(const JobStatus& s) {
                        : json(nullptr);
   // (Left out rather than null when the lease log could not be read, as before.)
   if (s.leases_issued) j["leases_issued"] = *s.leases_issued;
+  if (s.max_leases_per_unit) j["max_leases_per_unit"] = *s.max_leases_per_unit;
   if (s.reissued_acknowledged_passes) j["reissued_acknowledged_passes"] = *s.reissued_acknowledged_passes;
   return j;
 }

@@ -1,242 +1,19 @@
 #include "tessera/farm/protocol.h"
 
+#include "json_fields.h"
 #include "tessera/farm/sha256.h"
 
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <stdexcept>
 
 namespace tessera {
-namespace {
 
 using nlohmann::json;
-
-// Strict field reader: records the first error, names the field and what it should have been.
-class Fields {
- public:
-  Fields(const json& j, std::string& error, const char* what) : j_(j), error_(error), what_(what) {
-    if (!j.is_object()) fail(std::string(what) + ": expected a JSON object");
-  }
-  bool ok() const { return error_.empty(); }
-
-  template <class T>
-  void get(const char* name, T& out, bool required = false) {
-    seen_.insert(name);
-    if (!ok()) return;
-    auto it = j_.find(name);
-    if (it == j_.end() || it->is_null()) {
-      if (required) fail(std::string(what_) + ": missing field '" + name + "'");
-      return;
-    }
-    try {
-      if constexpr (std::is_same_v<T, bool>) {
-        if (!it->is_boolean()) throw std::invalid_argument("true or false");
-        out = it->template get<bool>();
-      } else if constexpr (std::is_integral_v<T>) {
-        if (!it->is_number_integer()) throw std::invalid_argument("an integer");
-        const bool in_range =
-            it->is_number_unsigned()
-                ? it->template get<uint64_t>() <= uint64_t(std::numeric_limits<T>::max())
-                : it->template get<int64_t>() >= int64_t(std::numeric_limits<T>::min()) &&
-                      (it->template get<int64_t>() < 0 ||
-                       uint64_t(it->template get<int64_t>()) <= uint64_t(std::numeric_limits<T>::max()));
-        if (!in_range) throw std::invalid_argument("an integer in range");
-        const int64_t v = it->is_number_unsigned() ? int64_t(it->template get<uint64_t>()) : it->template get<int64_t>();
-        out = T(v);
-      } else if constexpr (std::is_floating_point_v<T>) {
-        if (!it->is_number()) throw std::invalid_argument("a number");
-        out = it->template get<T>();
-      } else if constexpr (std::is_same_v<T, std::string>) {
-        if (!it->is_string()) throw std::invalid_argument("a string");
-        out = it->template get<std::string>();
-      } else {
-        out = it->template get<T>();
-      }
-    } catch (const std::exception& e) {
-      fail(std::string(what_) + ": field '" + name + "' must be " + e.what());
-    }
-  }
-  /// Absent or null leaves `out` empty.
-  template <class T>
-  void get(const char* name, std::optional<T>& out) {
-    T value{};
-    const bool present = j_.is_object() && j_.contains(name) && !j_[name].is_null();
-    get(name, value);
-    if (present && ok()) out = value;
-  }
-  void get_strings(const char* name, std::map<std::string, std::string>& out) {
-    seen_.insert(name);
-    if (!ok()) return;
-    auto it = j_.find(name);
-    if (it == j_.end() || it->is_null()) return;
-    if (!it->is_object()) return fail(std::string(what_) + ": field '" + name + "' must be an object of strings");
-    for (auto& [k, v] : it->items()) {
-      if (v.is_string()) out[k] = v.get<std::string>();
-      else if (v.is_number() || v.is_boolean()) out[k] = v.dump();
-      else return fail(std::string(what_) + ": field '" + name + "." + k + "' must be a string");
-    }
-  }
-  void get_list(const char* name, std::vector<std::string>& out) {
-    seen_.insert(name);
-    if (!ok()) return;
-    auto it = j_.find(name);
-    if (it == j_.end() || it->is_null()) return;
-    if (!it->is_array()) return fail(std::string(what_) + ": field '" + name + "' must be an array of strings");
-    for (auto& v : *it) {
-      if (!v.is_string()) return fail(std::string(what_) + ": field '" + name + "' must be an array of strings");
-      out.push_back(v.get<std::string>());
-    }
-  }
-  /// Unknown fields are errors: a misspelt "sp" must not render the scene's default spp.
-  void finish() {
-    if (!ok()) return;
-    for (auto& [k, v] : j_.items())
-      if (!seen_.count(k)) return fail(std::string(what_) + ": unknown field '" + k + "'");
-  }
-  void fail(const std::string& msg) {
-    if (error_.empty()) error_ = msg;
-  }
-
- private:
-  const json& j_;
-  std::string& error_;
-  const char* what_;
-  std::set<std::string> seen_;
-};
-
-}  // namespace
-
-json to_json(const JobSettings& s) {
-  json j = {{"name", s.name},   {"scene", s.scene},         {"scene_file", s.scene_file},
-            {"spp", s.spp},     {"width", s.width},         {"height", s.height},
-            {"seed", s.seed},   {"tile_size", s.tile_size}, {"priority", s.priority},
-            {"defines", s.defines}, {"integrator", s.integrator}, {"light_selection", s.light_selection},
-            {"target_error", s.target_error}, {"adaptive", s.adaptive}, {"denoise", s.denoise},
-            {"webhook", s.webhook}};
-  j["guiding"] = s.guiding ? json(*s.guiding) : json(nullptr);
-  return j;
-}
-
-namespace {
-
-// "12-20", "12..20", "7" or [12, 20]: an inclusive range.
-bool parse_frames(const json& j, int& first, int& last, std::string& error) {
-  try {
-    if (j.is_array() && j.size() == 2 && j[0].is_number_integer() && j[1].is_number_integer()) {
-      first = j[0].get<int>();
-      last = j[1].get<int>();
-    } else if (j.is_number_integer()) {
-      first = last = j.get<int>();
-    } else if (j.is_string()) {
-      const std::string s = j.get<std::string>();
-      size_t cut = s.find("..");
-      size_t skip = 2;
-      if (cut == std::string::npos) cut = s.find('-', 1), skip = 1;
-      size_t used = 0;
-      first = std::stoi(s.substr(0, cut), &used);
-      if (used != (cut == std::string::npos ? s.size() : cut)) throw std::invalid_argument("trailing characters");
-      last = first;
-      if (cut != std::string::npos) {
-        const std::string rest = s.substr(cut + skip);
-        last = std::stoi(rest, &used);
-        if (used != rest.size()) throw std::invalid_argument("trailing characters");
-      }
-    } else {
-      throw std::invalid_argument("type");
-    }
-  } catch (const std::exception&) {
-    error = "job settings: field 'frames' must be \"FIRST-LAST\", \"FIRST..LAST\", a frame number or [FIRST, LAST]";
-    return false;
-  }
-  if (last < first) {
-    error = "job settings: frames " + std::to_string(first) + ".." + std::to_string(last) + " ends before it starts";
-    return false;
-  }
-  return true;
-}
-
-}  // namespace
-
-bool job_request_from_json(const json& j, JobRequest& out, std::string& error, bool require_scene) {
-  if (!j.is_object() || !j.contains("frames")) {
-    out.frames.reset();
-    return job_settings_from_json(j, out.settings, error, require_scene);
-  }
-  int first = 0, last = 0;
-  if (!parse_frames(j["frames"], first, last, error)) return false;
-  json settings = j;
-  settings.erase("frames");
-  out.frames = std::pair{first, last};
-  return job_settings_from_json(settings, out.settings, error, require_scene);
-}
-
-bool job_settings_from_json(const json& j, JobSettings& out, std::string& error, bool require_scene) {
-  Fields f(j, error, "job settings");
-  f.get("name", out.name);
-  f.get("scene", out.scene, require_scene);
-  f.get("scene_file", out.scene_file);
-  f.get("spp", out.spp);
-  f.get("width", out.width);
-  f.get("height", out.height);
-  f.get("seed", out.seed);
-  f.get("tile_size", out.tile_size);
-  f.get("priority", out.priority);
-  f.get_strings("defines", out.defines);
-  f.get("integrator", out.integrator);
-  f.get("light_selection", out.light_selection);
-  f.get("target_error", out.target_error);
-  f.get("adaptive", out.adaptive);
-  f.get("guiding", out.guiding);
-  f.get("denoise", out.denoise);
-  f.get("webhook", out.webhook);
-  f.finish();
-  if (!f.ok()) return false;
-  if (!out.scene.empty() && !is_sha256_hex(out.scene)) {
-    error = "job settings: field 'scene' must be a bundle hash (64 lowercase hex digits)";
-    return false;
-  }
-  if (!(out.target_error >= 0 && out.target_error <= 1)) {
-    error = "job settings: field 'target_error' must be a relMSE in 0..1 (0: render every sample)";
-    return false;
-  }
-  if (!out.webhook.empty() && ((out.webhook.rfind("http://", 0) != 0 && out.webhook.rfind("https://", 0) != 0) ||
-                               out.webhook.size() > 2000)) {
-    error = "job settings: field 'webhook' must be an http:// or https:// URL";
-    return false;
-  }
-  if (out.name.size() > 200) {
-    error = "job settings: field 'name' is longer than 200 characters";
-    return false;
-  }
-  return true;
-}
-
-bool check_job_limits(const JobSettings& s, const JobLimits& l, std::string& error) {
-  auto fail = [&](const std::string& m) {
-    error = "job settings: " + m;
-    return false;
-  };
-  if (s.spp < 0 || s.spp > l.max_spp) return fail("spp " + std::to_string(s.spp) + " is outside 1.." + std::to_string(l.max_spp));
-  for (auto [name, v] : {std::pair{"width", s.width}, std::pair{"height", s.height}})
-    if (v < 0 || v > l.max_resolution)
-      return fail(std::string(name) + " " + std::to_string(v) + " is outside 1.." + std::to_string(l.max_resolution));
-  if (int64_t(s.width) * s.height > l.max_pixels) return fail("the image has more than " + std::to_string(l.max_pixels) + " pixels");
-  if (s.tile_size < l.min_tile_size || s.tile_size > l.max_tile_size)
-    return fail("tile_size " + std::to_string(s.tile_size) + " is outside " + std::to_string(l.min_tile_size) + ".." +
-                std::to_string(l.max_tile_size));
-  if (s.width > 0 && s.height > 0 && s.tile_size > 0) {
-    const int64_t tiles = int64_t((s.width + s.tile_size - 1) / s.tile_size) * ((s.height + s.tile_size - 1) / s.tile_size);
-    if (tiles > l.max_tiles)
-      return fail(std::to_string(tiles) + " tiles of " + std::to_string(s.tile_size) + " pixels exceed the limit of " +
-                  std::to_string(l.max_tiles) + " tiles (use a larger tile_size)");
-  }
-  if (!s.integrator.empty() && s.integrator != "path" && s.integrator != "volpath" && s.integrator != "direct")
-    return fail("integrator '" + s.integrator + "' is not path, volpath or direct");
-  if (!s.light_selection.empty() && s.light_selection != "power" && s.light_selection != "bvh")
-    return fail("light_selection '" + s.light_selection + "' is not power or bvh");
-  return true;
-}
+using json_fields::Fields;
 
 namespace {
 
@@ -455,6 +232,7 @@ std::string scene_cache_key(const JobSettings& s, const std::string& scene_file)
   json j = {{"scene", s.scene}, {"file", scene_file},         {"defines", s.defines},
             {"spp", s.spp},     {"width", s.width},           {"height", s.height},
             {"integrator", s.integrator}, {"light_selection", s.light_selection}};
+  if (s.allow_unsupported) j["allow_unsupported"] = true;  // (loads differently; absent keeps older keys)
   return sha256_hex(j.dump());
 }
 

@@ -1,18 +1,17 @@
 #include "connection_guard.h"
 
 #include "event_log.h"
+#include "own_sockets.h"
 
+#include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
-#include <arpa/inet.h>
 #include <dirent.h>
-#include <netdb.h>
-#include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
 #include <chrono>
-#include <cstring>
+#include <cmath>
 #include <set>
 
 namespace tessera::server {
@@ -23,35 +22,16 @@ double monotonic_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-int port_of(const sockaddr_storage& a) {
-  if (a.ss_family == AF_INET) return ntohs(reinterpret_cast<const sockaddr_in&>(a).sin_port);
-  if (a.ss_family == AF_INET6) return ntohs(reinterpret_cast<const sockaddr_in6&>(a).sin6_port);
-  return -1;
-}
-
-// "address:port" exactly as httplib writes remote_addr (getnameinfo, numeric) and remote_port.
-std::string peer_name(const sockaddr_storage& a, socklen_t len) {
-  char host[NI_MAXHOST];
-  if (getnameinfo(reinterpret_cast<const sockaddr*>(&a), len, host, sizeof host, nullptr, 0, NI_NUMERICHOST) != 0)
-    return "";
-  return std::string(host) + ":" + std::to_string(port_of(a));
-}
-
-// The inode of the socket behind `fd` ("socket:[1234]"), 0 if it is not a socket.
-uint64_t socket_inode(int fd) {
-  char link[64];
-  const std::string path = "/proc/self/fd/" + std::to_string(fd);
-  ssize_t n = readlink(path.c_str(), link, sizeof link - 1);
-  if (n <= 0) return 0;
-  link[n] = '\0';
-  if (std::strncmp(link, "socket:[", 8) != 0) return 0;
-  return std::strtoull(link + 8, nullptr, 10);
+std::string number(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", x);
+  return buf;
 }
 
 }  // namespace
 
-ConnectionGuard::ConnectionGuard(int listen_port, double header_timeout)
-    : listen_port_(listen_port), header_timeout_(header_timeout), thread_([this] { loop(); }) {}
+ConnectionGuard::ConnectionGuard(int listen_port, ConnectionLimits limits)
+    : listen_port_(listen_port), limits_(limits), thread_([this] { loop(); }) {}
 
 ConnectionGuard::~ConnectionGuard() {
   {
@@ -69,11 +49,44 @@ void ConnectionGuard::request_started(const std::string& peer) {
   p.since = monotonic_seconds();
 }
 
-void ConnectionGuard::request_finished(const std::string& peer) {
+void ConnectionGuard::body_expected(const std::string& peer, uint64_t bytes) {
   std::lock_guard<std::mutex> lock(mu_);
   Peer& p = peers_[peer];
-  p.in_request = false;
-  p.since = monotonic_seconds();
+  p.in_body = bytes > 0;
+  p.body_bytes = bytes;
+  p.body_seen = false;
+  p.last_progress = p.since;
+}
+
+void ConnectionGuard::body_read(const std::string& peer) {
+  std::lock_guard<std::mutex> lock(mu_);
+  auto it = peers_.find(peer);
+  if (it != peers_.end()) it->second.in_body = false;
+}
+
+std::string ConnectionGuard::body_timeout(const std::string& peer) {
+  std::lock_guard<std::mutex> lock(mu_);
+  auto it = peers_.find(peer);
+  return it == peers_.end() ? std::string() : it->second.timed_out;
+}
+
+void ConnectionGuard::close_after_answer(const std::string& peer) {
+  std::lock_guard<std::mutex> lock(mu_);
+  peers_[peer].close = true;
+}
+
+void ConnectionGuard::request_finished(const std::string& peer) {
+  bool close = false;
+  {
+    std::lock_guard<std::mutex> lock(mu_);
+    Peer& p = peers_[peer];
+    close = p.close;  // (a body cut off was shut down by the scan already)
+    p = Peer{};
+    p.since = monotonic_seconds();
+  }
+  // The answer is written (the logger runs after it): httplib's next read on this connection ends
+  // at once, and it closes the connection instead of reading the refused body as a request.
+  if (close) (void)shut_down_connection(listen_port_, peer, SHUT_RDWR);
 }
 
 void ConnectionGuard::loop() {
@@ -83,6 +96,50 @@ void ConnectionGuard::loop() {
     if (stop_) break;
     scan(monotonic_seconds());
   }
+}
+
+// Under mu_. True when the body of `p`, on socket `fd`, fell behind and was cut off.
+bool ConnectionGuard::check_body(int fd, const std::string& name, Peer& p, double now) {
+  uint64_t bytes = 0;
+  if (!bytes_received(fd, bytes)) return false;
+  if (!p.body_seen) {  // bytes before the first look are not counted: the rate is met a scan later
+    p.body_seen = true;
+    p.first_bytes = p.last_bytes = bytes;
+  } else if (bytes > p.last_bytes) {
+    p.last_bytes = bytes;
+    p.last_progress = now;
+  }
+  const double grace = limits_.body_grace, rate = limits_.min_body_rate;
+  const double late = now - p.since - grace;  // seconds past the grace
+  const double got = double(p.last_bytes - p.first_bytes);
+  if (now - p.last_progress > grace) {
+    p.timed_out = "the body stopped arriving: no byte for " + number(std::floor((now - p.last_progress) * 10) / 10) +
+                  " s; a body may pause at most " + number(grace) + " s (tessera-server --upload-grace)";
+  } else if (late > 0 && got < rate * late) {
+    p.timed_out = "the body arrived at " + number(std::round(got / (now - p.since))) + " bytes/s; after its first " +
+                  number(grace) + " s a body must average " + number(rate) +
+                  " bytes/s (tessera-server --min-upload-rate, --upload-grace), so this one of " +
+                  std::to_string(p.body_bytes) + " bytes had " +
+                  number(std::ceil(grace + double(p.body_bytes) / rate)) + " s";
+  } else {
+    return false;
+  }
+  // The 408 is written from here: httplib would not write it itself, since it takes a socket that
+  // its client has stopped sending on for gone. Over https the bytes would have to be encrypted
+  // by httplib's session, so the connection is only closed. The send never blocks: a client that
+  // does not read its answer loses it.
+  if (!limits_.tls) {
+    const std::string body = nlohmann::json{{"error", "body_too_slow"}, {"detail", p.timed_out}}.dump(2) + "\n";
+    const std::string answer = "HTTP/1.1 408 Request Timeout\r\nContent-Type: application/json\r\nContent-Length: " +
+                               std::to_string(body.size()) + "\r\nConnection: close\r\n\r\n" + body;
+    (void)::send(fd, answer.data(), answer.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
+  }
+  ::shutdown(fd, SHUT_RDWR);
+  p.in_body = false;
+  bodies_cut_off_.fetch_add(1);
+  log_event(spdlog::level::warn, "connection.cut_off",
+            {{"peer", name}, {"reason", "body_too_slow"}, {"detail", p.timed_out}});
+  return true;
 }
 
 // Under mu_ (the request hooks wait at most one scan of the descriptor table).
@@ -101,23 +158,20 @@ void ConnectionGuard::scan(double now) {
     if (known != sockets_.end()) {
       peer = known->second;
     } else {
-      sockaddr_storage local{}, remote{};
-      socklen_t llen = sizeof local, rlen = sizeof remote;
-      if (getsockname(fd, reinterpret_cast<sockaddr*>(&local), &llen) != 0 || port_of(local) != listen_port_) continue;
-      if (getpeername(fd, reinterpret_cast<sockaddr*>(&remote), &rlen) != 0) continue;  // the listener itself
-      peer = peer_name(remote, rlen);
+      peer = accepted_peer(fd, listen_port_);
       if (peer.empty()) continue;
       Peer& p = peers_[peer];
       if (!p.in_request) p.since = now;  // a new connection: its clock starts now
     }
     seen.emplace(inode, peer);
     Peer& p = peers_[peer];
-    if (p.in_request || now - p.since <= header_timeout_) continue;
+    if (p.in_body && socket_inode(fd) == inode) check_body(fd, peer, p, now);
+    if (p.in_request || now - p.since <= limits_.header_timeout) continue;
     // Still the same socket (the descriptor may have been closed and reused since readlink)?
     if (socket_inode(fd) != inode) continue;
     ::shutdown(fd, SHUT_RDWR);
     cut_off_.fetch_add(1);
-    log_event(spdlog::level::warn, "connection.cut_off", {{"peer", peer}, {"header_timeout", header_timeout_}});
+    log_event(spdlog::level::warn, "connection.cut_off", {{"peer", peer}, {"header_timeout", limits_.header_timeout}});
     p.since = now + 3600;  // once is enough; httplib closes it now
   }
   closedir(dir);

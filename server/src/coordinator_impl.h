@@ -82,6 +82,8 @@ struct Coordinator::Impl {
   // Leases (coordinator_leases.cpp).
   /// The scheduler's choice (scheduler.h) for a worker asking for work.
   std::optional<UnitChoice> choose_unit_for(uint64_t worker) TESSERA_REQUIRES(mu);
+  /// How long a lease of the job runs before it is overdue (none before its first unit is in).
+  std::optional<Clock::duration> speculation_threshold(const JobState& job) const TESSERA_REQUIRES(mu);
   /// Records a lease of the chosen unit and appends it to the log (the job starts with its first);
   /// the caller hands it out once `ticket` is durable, or ends it (end_lease).
   struct IssuedLease {
@@ -179,6 +181,12 @@ struct Coordinator::Impl {
   std::unique_ptr<JobState> job_from_row(const JobRow& row) const;
   /// A job rebuilt from its row and every stored result (its film included).
   std::unique_ptr<JobState> rebuild_job(const JobRow& row);
+  /// Checks and stores an uploaded bundle; `written` says whether this call wrote its file (it was
+  /// not stored before), so a submission refused later knows the bundle is its own to delete.
+  Result<SceneUpload> store_bundle(const std::string& bundle, bool& written);
+  /// Deletes a bundle this request wrote for a job that was refused (file, unpacked scene, row),
+  /// unless a job uses it by now (retention.cpp).
+  void discard_bundle(const std::string& hash) TESSERA_EXCLUDES(mu);
   /// The bundle unpacked into scene_dir (once; serialised per bundle) and the scene XML in it.
   Result<std::string> unpack_scene(const JobSettings& settings, const std::string& bundle_file);
   std::mutex unpack_mutexes_mu;  // (guards only the map of per-bundle mutexes below)

@@ -66,7 +66,12 @@ std::string read_file(const std::string& path) {
 }
 
 Result<SceneUpload> Coordinator::upload_scene(const std::string& bundle) {
-  Impl& s = *impl_;
+  bool written = false;
+  return impl_->store_bundle(bundle, written);
+}
+
+Result<SceneUpload> Coordinator::Impl::store_bundle(const std::string& bundle, bool& written) {
+  Impl& s = *this;
   if (bundle.size() > s.opt.max_upload_bytes)
     return make_error(Code::PayloadTooLarge, "bundle_too_large",
                       "the bundle has " + std::to_string(bundle.size()) + " bytes; the limit is " +
@@ -75,10 +80,12 @@ Result<SceneUpload> Coordinator::upload_scene(const std::string& bundle) {
   if (!inspected.ok()) return make_error(Code::BadRequest, "bad_bundle", inspected.error);
   const std::string hash = sha256_hex(bundle);
   try {
-    if (!touch_bundle(s.bundle_path(hash))) write_file_durably(s.bundle_path(hash), bundle);
+    written = !touch_bundle(s.bundle_path(hash));
+    if (written) write_file_durably(s.bundle_path(hash), bundle);
     s.store.add_scene(hash, bundle.size(), wall_seconds());
     s.metrics.counters.bytes_in += bundle.size();
   } catch (const std::exception& e) {
+    if (written) discard_bundle(hash);  // (refused after it was written: not kept)
     return internal_error(e);
   }
   SceneUpload upload{hash, bundle.size(), {}};
@@ -122,12 +129,13 @@ Result<JobSubmission> Coordinator::submit_frames(const JobRequest& request, cons
   const auto [first, last] = *request.frames;
   const int64_t max_frames = std::max(1, impl_->opt.max_active_jobs);
   if (int64_t(last) - first >= max_frames)
-    return make_error(Code::BadRequest, "bad_settings",
+    return make_error(Code::Unprocessable, "bad_settings",
                       "job settings: frames " + std::to_string(first) + ".." + std::to_string(last) +
                           " is not a range of 1.." + std::to_string(max_frames) + " frames");
   JobSettings base = request.settings;
+  bool written = false;
   if (!bundle.empty()) {
-    Result<SceneUpload> uploaded = upload_scene(bundle);
+    Result<SceneUpload> uploaded = impl_->store_bundle(bundle, written);
     if (!uploaded.ok()) return uploaded.status;
     base.scene = uploaded.value.hash;
   }
@@ -141,6 +149,7 @@ Result<JobSubmission> Coordinator::submit_frames(const JobRequest& request, cons
     Result<JobStatus> r = submit_one(std::move(one), "");
     if (!r.ok()) {
       for (const JobStatus& j : jobs) (void)cancel_job(j.id);
+      if (written && jobs.empty()) impl_->discard_bundle(base.scene);
       r.status.detail = "frame " + std::to_string(frame) + ": " + r.status.detail +
                         (jobs.empty() ? "" : " (the " + std::to_string(jobs.size()) + " frame(s) queued before were cancelled)");
       return r.status;
@@ -205,23 +214,32 @@ Result<JobStatus> Coordinator::submit_one(JobSettings settings, const std::strin
     MutexLock lock(s.mu);
     if (Status st = s.jobs.check_active(s.opt.max_active_jobs); !st.ok()) return st;
   }
+  bool written = false;
   if (!bundle.empty()) {
-    Result<SceneUpload> uploaded = upload_scene(bundle);
+    Result<SceneUpload> uploaded = s.store_bundle(bundle, written);
     if (!uploaded.ok()) return uploaded.status;
     settings.scene = uploaded.value.hash;
   }
-  if (!check_job_limits(settings, s.opt.limits, error)) return make_error(Code::Unprocessable, "bad_settings", error);
+  // A bundle that came with a job the coordinator refuses is not kept: nothing would ever use it.
+  const auto refuse = [&](Status st) {
+    if (written) s.discard_bundle(settings.scene);
+    return st;
+  };
+  if (!check_job_limits(settings, s.opt.limits, error)) return refuse(make_error(Code::Unprocessable, "bad_settings", error));
   Result<std::string> path = scene_bundle_path(settings.scene);
-  if (!path.ok()) return path.status;
+  if (!path.ok()) return refuse(path.status);
   Result<std::string> scene_file = s.unpack_scene(settings, path.value);
-  if (!scene_file.ok()) return scene_file.status;
+  if (!scene_file.ok()) return refuse(scene_file.status);
+  if (settings.name.empty()) settings.name = default_job_name(scene_file.value);
   const PlanRequest request{s.scene_dir(settings.scene), scene_file.value, settings};
   Result<JobPlan> plan = s.opt.scene_planner.empty() ? plan_scene_here(request)
                                                       : plan_scene_in_child(s.opt.scene_planner, request);
-  if (!plan.ok()) return plan.status;
+  if (!plan.ok()) return refuse(plan.status);
   if (!check_job_limits(plan.value.settings, s.opt.limits, error))
-    return make_error(Code::Unprocessable, "bad_settings", error);
-  return s.add_job(settings.name, std::move(plan.value));
+    return refuse(make_error(Code::Unprocessable, "bad_settings", error));
+  Result<JobStatus> added = s.add_job(settings.name, std::move(plan.value));
+  if (!added.ok()) return refuse(added.status);
+  return added;
 }
 
 Result<JobStatus> Coordinator::Impl::add_job(const std::string& name, JobPlan plan) {
@@ -316,6 +334,7 @@ JobStatus Coordinator::Impl::status_of(const JobState& job) {
 void Coordinator::Impl::add_lease_counts(JobStatus& status) {
   try {
     status.leases_issued = store.leases_issued(status.id);
+    status.max_leases_per_unit = store.max_leases_per_unit(status.id);
     status.reissued_acknowledged_passes = store.reissued_after_ack(status.id);
   } catch (const std::exception&) {
   }

@@ -2,6 +2,7 @@
 // long poll, heartbeats that keep leases alive, expiry, and the leases a restart inherits.
 #include "coordinator_impl.h"
 #include "event_log.h"
+#include "tessera/core/check.h"
 
 #include <spdlog/spdlog.h>
 
@@ -34,30 +35,45 @@ std::optional<UnitChoice> Coordinator::Impl::choose_unit_for(uint64_t worker) {
     return f != job.failures_by_worker.end() && f->second >= opt.worker_failure_limit;
   };
   const std::vector<JobCandidate> candidates = jobs.candidates(excluded);
+  // Only a worker holding no lease is idle enough for a copy of another's.
+  const bool speculate = opt.speculate && !leases.holds(worker);
   std::vector<LeaseCandidate> outstanding;
   // Leases are listed only when a job outranks the fresh choice (rare: a job's last units), and
   // only those of the jobs that do.
   const int floor = speculation_floor(candidates);
-  if (opt.speculate && !candidates.empty() && floor < candidates.front().priority) {
+  if (speculate && !candidates.empty() && floor < candidates.front().priority) {
+    const Clock::time_point now = Clock::now();
     std::vector<std::pair<uint64_t, LeaseCandidate>> by_age;
     for (const JobCandidate& c : candidates) {
       if (c.priority <= floor) break;
       const JobState& job = *jobs.find(c.job);
+      const std::optional<Clock::duration> after = speculation_threshold(job);
       for (uint64_t id : leases.job_leases(c.job)) {
         const LeaseInfo& l = *leases.find(id);
-        by_age.push_back({id, {l.job, c.priority, l.unit, l.worker, job.active_leases(l.unit), c.excluded}});
+        LeaseCandidate lc{l.job, c.priority, l.unit, l.worker, job.active_leases(l.unit), c.excluded};
+        lc.finished = job.unit_finished(l.unit);
+        lc.overdue = after && now - l.issued > *after;
+        by_age.push_back({id, lc});
       }
     }
     std::sort(by_age.begin(), by_age.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
     for (const auto& [id, l] : by_age) outstanding.push_back(l);
   }
-  return choose_unit(candidates, outstanding, worker, opt.speculate);
+  return choose_unit(candidates, outstanding, worker, speculate);
+}
+
+std::optional<Clock::duration> Coordinator::Impl::speculation_threshold(const JobState& job) const {
+  if (opt.speculate_after == 0) return Clock::duration::zero();
+  const std::optional<double> median = job.unit_times.median();
+  if (!median) return std::nullopt;  // (no unit in yet: nothing to call late)
+  return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(opt.speculate_after * *median));
 }
 
 Coordinator::Impl::IssuedLease Coordinator::Impl::issue_lease(uint64_t worker, WorkerInfo& w,
                                                               const UnitChoice& choice) {
   JobState& job = *jobs.find(choice.job);
   const size_t unit = choice.unit;
+  TESSERA_CHECK(!job.unit_finished(unit));  // (an accepted unit is never leased again)
   const double now = wall_seconds();
   IssuedLease issued;
   // The job's first lease: its phase is logged ahead of the lease.
@@ -85,13 +101,16 @@ Coordinator::Impl::IssuedLease Coordinator::Impl::issue_lease(uint64_t worker, W
       [this, id = l.id](bool durable) TESSERA_REQUIRES(mu) {
         if (!durable) end_lease(id);  // not logged: never handed out
       });
-  add_lease(LeaseInfo{l.id, l.job_id, worker, unit, Clock::now() + dead_after()});
+  const auto now_steady = Clock::now();
+  add_lease(LeaseInfo{l.id, l.job_id, worker, unit, now_steady + dead_after(), now_steady});
   set_worker_state(worker, w, WorkerState::Busy);
   if (job.lease_job_part_bytes == 0) job.lease_job_part_bytes = lease_job_part_bytes(l);
   const size_t bytes = lease_json_bytes(l, job.lease_job_part_bytes);
   job.lease_bytes += bytes;
   metrics.counters.bytes_out += bytes;
   ++metrics.counters.leased;
+  job.lease_issued(unit);
+  metrics.note_leases_per_unit(job.max_leases_per_unit());
   if (choice.speculative) ++metrics.counters.speculative;
   log_event(spdlog::level::debug, "lease.issued",
             {{"lease", l.id}, {"job", l.job_id}, {"tile", l.tile}, {"pass", l.pass}, {"worker", worker},
@@ -179,7 +198,7 @@ bool Coordinator::Impl::keep_lease(uint64_t worker, const HeldLease& held) {
   if (!job || is_terminal(job->phase()) || !job->has_unit(held.tile, held.pass)) return false;
   const size_t unit = job->unit(held.tile, held.pass);
   if (job->is_done(unit)) return false;
-  add_lease(LeaseInfo{held.id, held.job, worker, unit, Clock::now() + dead_after()});
+  add_lease(LeaseInfo{held.id, held.job, worker, unit, Clock::now() + dead_after(), Clock::now()});
   return true;
 }
 
@@ -190,7 +209,7 @@ void Coordinator::Impl::hold_open_leases(JobState& job) {
     if (!job.has_unit(l.tile, l.pass)) continue;
     const size_t unit = job.unit(l.tile, l.pass);
     if (job.is_done(unit)) continue;
-    add_lease(LeaseInfo{l.id, job.id(), l.worker, unit, Clock::now() + dead_after()});
+    add_lease(LeaseInfo{l.id, job.id(), l.worker, unit, Clock::now() + dead_after(), Clock::now()});
   }
 }
 

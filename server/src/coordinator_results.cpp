@@ -33,9 +33,9 @@ Status Coordinator::Impl::check_tile_result(const JobState& job, size_t unit, co
       result.sample_end != job.sample_end(unit))
     return make_error(Code::BadRequest, "bad_result", "the result's rectangle or samples do not match the unit");
   if (job.is_done(unit)) return Status::success();  // (a late copy: a duplicate, compared with the first)
-  if (result.film.has_aovs() != job.plan().settings.denoise)
+  if (result.film.has_aovs() != job.plan().settings.sums_aovs())
     return make_error(Code::BadRequest, "bad_result",
-                      job.plan().settings.denoise ? "a result of a denoised job must carry the AOV sums (format version 4)"
+                      job.plan().settings.sums_aovs() ? "a result of a job with AOVs must carry the AOV sums (format version 4)"
                                                   : "the result carries AOV sums the job did not ask for");
   if (!job.result_fits(unit, result.film))
     return make_error(Code::BadRequest, "bad_result",
@@ -87,6 +87,7 @@ void Coordinator::Impl::result_committed(bool durable, uint64_t job_id, size_t u
   const bool added = upload.tile ? job.add_result(unit, std::move(upload.tile->film), worker, upload.records())
                                  : job.add_splats(unit, std::move(upload.splats->splats), worker, upload.records());
   if (!added) return;  // (a retry rebuilt it meanwhile)
+  job.unit_times.add(upload.seconds());
   save_decisions(job);
   if (upload.tile) checkpoint_tile(job, job.tile_of(unit), 1);
   fold_splats(job);
@@ -192,7 +193,7 @@ BodyLimit Coordinator::result_limit(uint64_t worker, uint64_t lease) {
     }
     if (job) {
       const TileRect& r = job->rect(l->unit);
-      const bool aovs = job->plan().settings.denoise, training = job->sequencer().pass(job->pass_of(l->unit)).feeds.has_value();
+      const bool aovs = job->plan().settings.sums_aovs(), training = job->sequencer().pass(job->pass_of(l->unit)).feeds.has_value();
       return {max_tile_result_bytes(r, aovs, training),
               "a result of lease " + std::to_string(lease) + " (a " + std::to_string(r.width()) + "x" +
                   std::to_string(r.height()) + " tile" + (aovs ? ", with AOV sums" : "") +

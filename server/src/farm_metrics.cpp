@@ -18,6 +18,9 @@ std::string passes(const FarmCounters& c) {
                           std::pair{"duplicate", c.duplicates.load()}, std::pair{"speculative", c.speculative.load()},
                           std::pair{"mismatched", c.mismatched.load()}})
     out += std::string("tessera_passes_total{event=\"") + event + "\"} " + std::to_string(n) + "\n";
+  out += metric_header("tessera_max_leases_per_unit", "gauge",
+                       "The most leases issued for one unit of any job since the coordinator started.");
+  out += "tessera_max_leases_per_unit " + std::to_string(c.max_leases_per_unit.load()) + "\n";
   return out;
 }
 

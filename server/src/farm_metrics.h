@@ -18,6 +18,8 @@ namespace tessera::server {
 struct FarmCounters {
   std::atomic<uint64_t> leased{0}, done{0}, expired{0}, failed{0}, duplicates{0}, speculative{0}, mismatched{0};
   std::atomic<uint64_t> bytes_in{0}, bytes_out{0};
+  // The most leases this process issued for one unit of any job (1: nothing leased twice).
+  std::atomic<uint64_t> max_leases_per_unit{0};
 };
 
 /// The state /metrics shows beside the counters, copied under the coordinator's lock.
@@ -42,6 +44,11 @@ class FarmMetrics {
   Histogram lease_wait{{0.001, 0.01, 0.1, 0.5, 1, 2.5, 5, 10, 20, 30}};
   Histogram upload_seconds{{0.0005, 0.001, 0.0025, 0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 1}};
 
+  void note_leases_per_unit(uint64_t n) {
+    uint64_t seen = counters.max_leases_per_unit.load();
+    while (n > seen && !counters.max_leases_per_unit.compare_exchange_weak(seen, n)) {
+    }
+  }
   /// The whole /metrics page.
   std::string render(const MetricsSnapshot& snapshot) const;
 };

@@ -1,5 +1,7 @@
 #include "http_helpers.h"
 
+#include "connection_guard.h"
+
 namespace tessera::server {
 
 using nlohmann::json;
@@ -53,6 +55,36 @@ double query_number(const httplib::Request& req, const char* name, double def) {
 std::string bundle_of(const httplib::Request& req) {
   if (req.is_multipart_form_data()) return req.has_file("bundle") ? req.get_file_value("bundle").content : "";
   return req.body;
+}
+
+std::string peer_of(const httplib::Request& req) { return req.remote_addr + ":" + std::to_string(req.remote_port); }
+
+httplib::Server::Handler Router::watched(httplib::Server::Handler h) const {
+  if (!guard_) return h;
+  return [guard = guard_, h = std::move(h)](const httplib::Request& req, httplib::Response& res) {
+    guard->body_read(peer_of(req));
+    h(req, res);
+  };
+}
+
+httplib::Server::HandlerWithContentReader Router::watched(httplib::Server::HandlerWithContentReader h) const {
+  if (!guard_) return h;
+  return [guard = guard_, h = std::move(h)](const httplib::Request& req, httplib::Response& res,
+                                            const httplib::ContentReader& reader) {
+    const std::string peer = peer_of(req);
+    const httplib::ContentReader read_then_tell(
+        [&](httplib::ContentReceiver receiver) {
+          const bool ok = reader(std::move(receiver));
+          guard->body_read(peer);
+          return ok;
+        },
+        [&](httplib::MultipartContentHeader header, httplib::ContentReceiver receiver) {
+          const bool ok = reader(std::move(header), std::move(receiver));
+          guard->body_read(peer);
+          return ok;
+        });
+    h(req, res, read_then_tell);
+  };
 }
 
 }  // namespace tessera::server

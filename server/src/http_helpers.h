@@ -44,25 +44,33 @@ double query_number(const httplib::Request& req, const char* name, double def);
 /// A bundle, sent as the raw body (curl --data-binary) or as the multipart field "bundle".
 std::string bundle_of(const httplib::Request& req);
 
-/// Registers routes with httplib and keeps their list.
+/// "address:port" of the request's connection, as the connection guard names peers.
+std::string peer_of(const httplib::Request& req);
+
+/// Registers routes with httplib and keeps their list. With a connection guard, each handler first
+/// tells it that the request's body is in (a handler that reads the body itself: once it has), so
+/// that the time a handler takes is never taken for a body that stopped arriving.
 class Router {
  public:
-  explicit Router(httplib::Server& http) : http_(http) {}
-  void get(const char* pattern, httplib::Server::Handler h) { add("GET", pattern), http_.Get(pattern, std::move(h)); }
-  void post(const char* pattern, httplib::Server::Handler h) { add("POST", pattern), http_.Post(pattern, std::move(h)); }
+  explicit Router(httplib::Server& http, ConnectionGuard* guard = nullptr) : http_(http), guard_(guard) {}
+  void get(const char* pattern, httplib::Server::Handler h) { add("GET", pattern), http_.Get(pattern, watched(std::move(h))); }
+  void post(const char* pattern, httplib::Server::Handler h) { add("POST", pattern), http_.Post(pattern, watched(std::move(h))); }
   /// A POST whose handler reads the body itself (as it arrives).
   void post(const char* pattern, httplib::Server::HandlerWithContentReader h) {
-    add("POST", pattern), http_.Post(pattern, std::move(h));
+    add("POST", pattern), http_.Post(pattern, watched(std::move(h)));
   }
-  void patch(const char* pattern, httplib::Server::Handler h) { add("PATCH", pattern), http_.Patch(pattern, std::move(h)); }
-  void del(const char* pattern, httplib::Server::Handler h) { add("DELETE", pattern), http_.Delete(pattern, std::move(h)); }
+  void patch(const char* pattern, httplib::Server::Handler h) { add("PATCH", pattern), http_.Patch(pattern, watched(std::move(h))); }
+  void del(const char* pattern, httplib::Server::Handler h) { add("DELETE", pattern), http_.Delete(pattern, watched(std::move(h))); }
   void add(const std::vector<Route>& more) { routes_.insert(routes_.end(), more.begin(), more.end()); }
   httplib::Server& http() { return http_; }
   std::vector<Route> take() { return std::move(routes_); }
 
  private:
   void add(const char* method, const char* pattern) { routes_.push_back({method, pattern}); }
+  httplib::Server::Handler watched(httplib::Server::Handler h) const;
+  httplib::Server::HandlerWithContentReader watched(httplib::Server::HandlerWithContentReader h) const;
   httplib::Server& http_;
+  ConnectionGuard* guard_;
   std::vector<Route> routes_;
 };
 

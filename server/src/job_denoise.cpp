@@ -33,7 +33,7 @@ void Coordinator::Impl::complete_job(JobState& job) {
   // Its sums durable first, as finish_job does: the images take a while.
   for (uint32_t t = 0; t < job.num_tiles(); ++t) checkpoint_tile(job, t, 1);
   log_event(spdlog::level::info, "job.denoise_started", {{"job", job.id()}});
-  denoising.push([this, id = job.id(), attributes = image_attributes(job)] {
+  denoising.push([this, id = job.id(), attributes = image_attributes(job), job_settings = job.plan().settings] {
     std::string error;
     bool raw_written = false;
     double seconds = 0;
@@ -41,14 +41,18 @@ void Coordinator::Impl::complete_job(JobState& job) {
       std::vector<ImageLayer> layers;
       const std::optional<Image> raw = film_image(id, /*consistent=*/true, &layers);
       if (!raw) return;  // (the job was deleted meanwhile)
-      write_image_durably(image_path(id), *raw, attributes, opt.data_dir, layers);
+      // The denoiser reads every layer; the EXRs carry those the job asked for (all unless `aovs` says).
+      std::vector<ImageLayer> kept = layers;
+      keep_job_exr_layers(job_settings, kept);
+      write_image_durably(image_path(id), *raw, attributes, opt.data_dir, kept);
       raw_written = true;
       const auto start = std::chrono::steady_clock::now();
       DenoiseSettings settings;
       settings.threads = opt.denoise_threads;
+      if (job_settings.denoise_mode == "preview") settings.mode = DenoiseMode::Preview;
       const Image denoised = denoise(make_denoise_input(*raw, layers), settings);
       seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      write_image_durably(denoised_path(id), denoised, attributes, opt.data_dir, layers);  // (both carry the AOVs)
+      write_image_durably(denoised_path(id), denoised, attributes, opt.data_dir, kept);  // (both carry the AOVs)
     } catch (const std::exception& e) {
       error = std::string(raw_written ? "denoising failed: " : "the raw image was not written: ") + e.what();
     }

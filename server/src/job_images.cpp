@@ -35,6 +35,38 @@ Status denoised_image_status(const JobState& job) {
   return Status::success();
 }
 
+// The image (and for an EXR its layers) encoded as `format` through a file in DATA_DIR/tmp, checked
+// before it is sent, since a full disk can truncate it silently. Throws.
+ImageBytes encode_image(const std::string& data_dir, const std::string& format, const Image& image,
+                        const std::vector<ImageLayer>& layers, const JobPlan& plan, const ImageAttributes& attributes) {
+  static std::atomic<uint64_t> counter{0};
+  const std::string tmp = (fs::path(data_dir) / "tmp" /
+                           ("image-" + std::to_string(::getpid()) + "-" + std::to_string(++counter) + "." + format))
+                              .string();
+  try {
+    if (format == "png") {
+      LdrSettings ldr;
+      if (plan.ldr) {
+        ldr.gamma = plan.gamma;
+        ldr.exposure = plan.exposure;
+      }
+      write_png(tmp, image, ldr);
+    } else if (layers.empty()) {
+      write_image(tmp, image, attributes);
+    } else {
+      write_exr_layers(tmp, image, layers, attributes);
+    }
+    verify_image_file(tmp, format, image, data_dir);
+    ImageBytes out{read_file(tmp), format == "png" ? "image/png" : format == "exr" ? "image/x-exr" : "image/x-pfm"};
+    fs::remove(tmp);
+    return out;
+  } catch (const std::exception&) {
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    throw;
+  }
+}
+
 }  // namespace
 
 void Coordinator::Impl::finish_job(JobState& job, bool notify) {
@@ -50,12 +82,14 @@ void Coordinator::Impl::finish_job(JobState& job, bool notify) {
   // The image is written off the lock; until then it is served from the film.
   job.image_pending = true;
   ImageAttributes attributes = image_attributes(job);
-  background.push([this, id = job.id(), attributes = std::move(attributes), notify] {
+  background.push([this, id = job.id(), attributes = std::move(attributes), notify, settings = job.plan().settings] {
     std::string error;
     try {
-      std::optional<Image> image = film_image(id, /*consistent=*/true);
+      std::vector<ImageLayer> layers;  // (the AOV layers the job asked for)
+      std::optional<Image> image = film_image(id, /*consistent=*/true, settings.sums_aovs() ? &layers : nullptr);
       if (!image) return;  // (the job was deleted meanwhile)
-      write_image_durably(image_path(id), *image, attributes, opt.data_dir);
+      keep_job_exr_layers(settings, layers);
+      write_image_durably(image_path(id), *image, attributes, opt.data_dir, layers);
     } catch (const std::exception& e) {
       error = e.what();
     }
@@ -143,13 +177,17 @@ Result<ImageBytes> Coordinator::job_image(uint64_t id, const std::string& format
     from_film = !denoised && job.has_film();
   }
   if (preview) image = *preview;
+  std::vector<ImageLayer> layers;  // an EXR from the film carries the AOV layers the job asked for
   if (from_film) {  // (or released meanwhile, once its image is on disk)
-    if (std::optional<Image> converted = s.film_image(id, /*consistent=*/false)) image = std::move(*converted);
+    const bool with_layers = format == "exr" && plan.settings.sums_aovs();
+    if (std::optional<Image> converted = s.film_image(id, /*consistent=*/false, with_layers ? &layers : nullptr))
+      image = std::move(*converted);
+    keep_job_exr_layers(plan.settings, layers);
   }
   if (image.width() == 0) {  // an ended job: its images are on disk
     const std::string path = denoised ? s.denoised_path(id) : s.image_path(id);
     try {
-      // As stored: a denoised job's raw EXR carries the AOV layers.
+      // As stored: the raw EXR of a job with AOVs or denoised carries the AOV layers.
       if (format == "exr") {
         ImageBytes out{read_file(path), "image/x-exr"};
         s.metrics.counters.bytes_out += out.bytes.size();
@@ -160,33 +198,15 @@ Result<ImageBytes> Coordinator::job_image(uint64_t id, const std::string& format
       return internal_error(e);
     }
   }
-  static std::atomic<uint64_t> counter{0};
-  const std::string tmp = (fs::path(s.opt.data_dir) / "tmp" /
-                           ("image-" + std::to_string(::getpid()) + "-" + std::to_string(++counter) + "." + format))
-                              .string();
   try {
-    if (format == "png") {
-      LdrSettings ldr;
-      if (plan.ldr) {
-        ldr.gamma = plan.gamma;
-        ldr.exposure = plan.exposure;
-      }
-      write_png(tmp, image, ldr);
-    } else {
-      write_image(tmp, image,
-                  {{"tessera_version", TESSERA_VERSION},
-                   {"tessera_job", std::to_string(id)},
-                   {"tessera_spp", std::to_string(spp)},
-                   {"tessera_seed", std::to_string(plan.settings.seed)}});
-    }
-    verify_image_file(tmp, format, image, s.opt.data_dir);  // (a full disk can truncate it silently)
-    ImageBytes out{read_file(tmp), format == "png" ? "image/png" : format == "exr" ? "image/x-exr" : "image/x-pfm"};
-    fs::remove(tmp);
+    ImageBytes out = encode_image(s.opt.data_dir, format, image, layers, plan,
+                                  {{"tessera_version", TESSERA_VERSION},
+                                   {"tessera_job", std::to_string(id)},
+                                   {"tessera_spp", std::to_string(spp)},
+                                   {"tessera_seed", std::to_string(plan.settings.seed)}});
     s.metrics.counters.bytes_out += out.bytes.size();
     return out;
   } catch (const std::exception& e) {
-    std::error_code ec;
-    fs::remove(tmp, ec);
     return internal_error(e);
   }
 }

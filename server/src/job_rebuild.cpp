@@ -62,7 +62,7 @@ std::unique_ptr<JobState> Coordinator::Impl::rebuild_job(const JobRow& row) {
     std::string err;
     if (!decode_tile_result(c.data, sums, err)) throw std::runtime_error(where + "stored checkpoint is corrupt: " + err);
     if (c.tile >= job->num_tiles() || c.passes == 0 || c.passes > job->num_passes() ||
-        !(sums.film.rect() == job->rect(job->unit(c.tile, 0))) || sums.film.has_aovs() != job->plan().settings.denoise ||
+        !(sums.film.rect() == job->rect(job->unit(c.tile, 0))) || sums.film.has_aovs() != job->plan().settings.sums_aovs() ||
         sums.sample_end != job->sample_end(job->unit(c.tile, c.passes - 1)))
       throw std::runtime_error(where + "stored checkpoint of tile " + std::to_string(c.tile) + " does not fit the job");
     job->restore_checkpoint(c.tile, c.passes, std::move(sums.film));
@@ -77,7 +77,7 @@ std::unique_ptr<JobState> Coordinator::Impl::rebuild_job(const JobRow& row) {
     Result<UnitUpload> stored = decode_upload(r.data, int64_t(1) << 30);
     if (!stored.ok()) throw std::runtime_error(where + "stored result is corrupt: " + stored.status.detail);
     const UnitUpload& u = stored.value;
-    if (job->is_tile_unit(unit) != bool(u.tile) || (u.tile && u.tile->film.has_aovs() != job->plan().settings.denoise))
+    if (job->is_tile_unit(unit) != bool(u.tile) || (u.tile && u.tile->film.has_aovs() != job->plan().settings.sums_aovs()))
       throw std::runtime_error(where + "a stored result of pass " + std::to_string(r.pass) + " does not fit the job");
     (void)(u.tile ? job->add_result(unit, std::move(u.tile->film), r.worker)
                   : job->add_splats(unit, std::move(u.splats->splats), r.worker));

@@ -35,7 +35,7 @@ PassSequencer job_sequencer(const JobPlan& plan) {
   // The same sequencer `tessera render` runs with these settings (path_program.h), with the passes
   // planned at submission.
   PassSequencer seq = path_sequencer(job_program(plan), SequenceFrame{plan.window, plan.full_width, plan.full_height,
-                                                                  plan.settings.tile_size, plan.settings.denoise},
+                                                                  plan.settings.tile_size, plan.settings.sums_aovs()},
                                      plan.guide);
   if (std::string e = farm_program_error(seq.program()); !e.empty()) throw std::invalid_argument(e);
   return seq;
@@ -48,6 +48,7 @@ JobState::JobState(uint64_t id, JobPlan plan, std::string name, int priority, do
       seq_(job_sequencer(plan_)) {
   committing_.assign(num_units(), 0);
   active_leases_.assign(num_units(), 0);
+  leases_issued_.assign(num_units(), 0);
   accepted_from_.assign(num_units(), 0);
   folded_.assign(num_tiles(), 0);
   tile_committing_.assign(num_tiles(), 0);
@@ -84,6 +85,11 @@ std::optional<size_t> JobState::next_unit() const {
   for (size_t u = cursor_; u < open_end; ++u)  // (past units waiting for their tile's state)
     if (leasable(u)) return u;
   return std::nullopt;
+}
+
+void JobState::lease_issued(size_t unit) {
+  if (leases_issued_[unit] < UINT16_MAX) ++leases_issued_[unit];
+  max_leases_per_unit_ = std::max<unsigned>(max_leases_per_unit_, leases_issued_[unit]);
 }
 
 void JobState::lease_ended(size_t unit) {

@@ -4,6 +4,7 @@
 // checkpoints that stand in for a tile's stored results.
 #pragma once
 
+#include "unit_times.h"
 #include "tessera/farm/job_scene.h"
 #include "tessera/farm/sha256.h"
 #include "tessera/image/image.h"
@@ -125,6 +126,12 @@ class JobState {
   /// passes units leased or done once, and units handed back are kept apart.
   std::optional<size_t> next_unit() const;
   void lease_started(size_t unit) { ++active_leases_[unit]; }
+  /// A lease of the unit was issued (not re-adopted): counted per unit, for max_leases_per_unit.
+  void lease_issued(size_t unit);
+  /// The most leases this process issued for any one unit of the job.
+  unsigned max_leases_per_unit() const { return max_leases_per_unit_; }
+  /// Whether a speculative copy of the unit may be leased: neither done nor being committed.
+  bool unit_finished(size_t unit) const { return is_done(unit) || is_committing(unit); }
   unsigned active_leases(size_t unit) const { return active_leases_[unit]; }
   void lease_ended(size_t unit);
   bool is_done(size_t unit) const { return seq_.is_done(unit); }
@@ -203,6 +210,7 @@ class JobState {
   std::map<uint64_t, int> failures_by_worker;
   std::string last_failure;
   uint64_t duplicates = 0;
+  UnitTimes unit_times;  // render seconds of its accepted units (the speculation threshold's base)
   uint64_t mismatched = 0;  // duplicates whose sums differed from the accepted result's
   uint64_t result_bytes = 0;  // compressed bytes of the accepted results (the network cost)
   uint64_t lease_bytes = 0;   // JSON bytes of the leases handed out
@@ -233,6 +241,8 @@ class JobState {
   PassSequencer seq_;
   std::vector<uint8_t> committing_;              // per unit
   std::vector<uint16_t> active_leases_;          // per unit
+  std::vector<uint16_t> leases_issued_;          // per unit (saturating)
+  unsigned max_leases_per_unit_ = 0;
   std::vector<uint64_t> accepted_from_;          // per done unit: the worker its result came from
   std::vector<uint32_t> folded_;                 // per tile: passes in its checkpoint
   std::vector<uint16_t> tile_committing_;        // per tile: results being committed

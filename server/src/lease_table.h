@@ -22,6 +22,7 @@ struct LeaseInfo {
   uint64_t id = 0, job = 0, worker = 0;
   size_t unit = 0;
   Clock::time_point expires;
+  Clock::time_point issued;  // (for a lease re-adopted after a restart: when it was re-adopted)
 };
 
 class LeaseTable {

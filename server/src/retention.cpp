@@ -238,6 +238,24 @@ bool Coordinator::Impl::move_expired_bundle(const std::string& hash, const Reten
   return true;
 }
 
+void Coordinator::Impl::discard_bundle(const std::string& hash) {
+  {
+    // A job that took the same bundle meanwhile keeps it (as retention leaves a referenced one).
+    MutexLock lock(mu);
+    for (const auto& [id, job] : jobs.all())
+      if (job->plan().settings.scene == hash) return;
+  }
+  std::error_code ec;
+  fs::remove(bundle_path(hash), ec);
+  fs::remove_all(scene_dir(hash), ec);
+  try {
+    store.delete_scene(hash);
+  } catch (const std::exception& e) {
+    spdlog::warn("cannot forget refused bundle {}: {}", hash, e.what());
+  }
+  log_event(spdlog::level::info, "bundle.refused", {{"scene", hash}});
+}
+
 Result<RetentionReport> Coordinator::apply_retention(double now) {
   std::optional<RetentionReport> report = impl_->run_retention(now > 0 ? now : wall_seconds());
   if (!report) return make_error(Code::Internal, "retention_failed", "cannot measure stored results");

@@ -23,8 +23,9 @@ void submit(Coordinator& c, const httplib::Request& req, httplib::Response& res)
   }
   JobRequest request;
   std::string error;
-  if (!job_request_from_json(settings, request, error, /*require_scene=*/bundle.empty()))
-    return send_error(res, make_error(Code::BadRequest, "bad_settings", error));
+  bool out_of_range = false;  // (a well-formed value outside its field's range: 422, as the limits)
+  if (!job_request_from_json(settings, request, error, /*require_scene=*/bundle.empty(), &out_of_range))
+    return send_error(res, make_error(out_of_range ? Code::Unprocessable : Code::BadRequest, "bad_settings", error));
   send(res, c.submit_job(request, bundle), 201);
 }
 

@@ -32,7 +32,7 @@ std::optional<UnitChoice> choose_unit(std::span<const JobCandidate> jobs, std::s
   if (!speculate) return fresh;
   const LeaseCandidate* best = nullptr;
   for (const LeaseCandidate& l : leases) {
-    if (l.excluded || l.worker == worker || l.copies != 1) continue;
+    if (l.excluded || l.finished || !l.overdue || l.worker == worker || l.copies != 1) continue;
     if (fresh && l.priority <= floor) continue;
     if (!best || l.priority > best->priority) best = &l;  // (equal: the older lease stays)
   }

@@ -3,9 +3,12 @@
 //
 // Fresh work first: the highest-priority job (earliest submitted among equals) that has an unleased
 // unit in its open passes the worker may take. When no job of equal or higher priority has one, an
-// idle worker gets a speculative copy of the oldest outstanding unit of a higher-priority job (one
-// extra copy per unit at most, never of its own lease): the last units of a job no longer wait on
-// the slowest (or a silently dead) worker. The first result to arrive wins.
+// idle worker gets a speculative copy of the oldest overdue unit of a higher-priority job: the last
+// units of a job no longer wait on the slowest (or a silently dead) worker. The first result to
+// arrive wins. Bounded by construction: a copy is only of a unit with exactly one lease in flight
+// (so at most one extra copy), never of a unit whose result is in or being committed, never of the
+// worker's own lease, and only once the lease has run longer than the job's speculation threshold
+// (a multiple of its median unit time).
 #pragma once
 
 #include <cstddef>
@@ -31,6 +34,8 @@ struct LeaseCandidate {
   uint64_t worker = 0;
   unsigned copies = 0;    // leases of the unit in flight, this one included
   bool excluded = false;  // the asking worker may not take this job's work
+  bool finished = false;  // the unit's result is in, or being committed: never leased again
+  bool overdue = false;   // the lease has run longer than its job's speculation threshold
 };
 
 struct UnitChoice {
@@ -39,7 +44,8 @@ struct UnitChoice {
   bool speculative = false;
 };
 
-/// The unit for `worker`, or none. With `speculate` false only fresh units are handed out.
+/// The unit for `worker`, or none. With `speculate` false (speculation off, or a worker that still
+/// holds a lease: not idle) only fresh units are handed out.
 std::optional<UnitChoice> choose_unit(std::span<const JobCandidate> jobs, std::span<const LeaseCandidate> leases,
                                       uint64_t worker, bool speculate);
 

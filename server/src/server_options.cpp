@@ -13,7 +13,8 @@ void add_service_options(CLI::App& app, ServerOptions& o) {
   app.add_option("--listen", o.listen, "HOST:PORT to listen on (port 0: any free port)")->capture_default_str();
   app.add_option("--port-file", o.port_file, "write the port actually bound to this file");
   app.add_option("--data-dir", c.data_dir, "directory for the state database, bundles and scenes")->capture_default_str();
-  app.add_option("--http-threads", o.http_threads, "HTTP worker threads (long polls use at most half of them)")
+  app.add_option("--http-threads", o.http_threads,
+                 "HTTP worker threads (long polls use at most half of them); uploads have threads of their own")
       ->check(CLI::Range(2, 4096))->capture_default_str();
   app.add_option("--local-workers", o.local_workers, "also run N workers on this machine")->check(CLI::Range(0, 256));
   app.add_option("--local-worker-threads", o.local_worker_threads, "threads per local worker (default: cores / N)");
@@ -23,6 +24,10 @@ void add_service_options(CLI::App& app, ServerOptions& o) {
       ->check(CLI::Range(0.1, 600.0))->capture_default_str();
   app.add_flag("!--no-speculation", c.speculate,
                "never lease a second copy of an outstanding unit to an idle worker (each unit is leased once)");
+  app.add_option("--speculate-after", c.speculate_after,
+                 "an idle worker may get a copy of a unit whose lease has run this many times the job's median "
+                 "unit time (0: at once)")
+      ->check(CLI::Range(0.0, 1000.0))->capture_default_str();
   app.add_option("--max-poll-wait", c.max_poll_wait, "longest lease long poll, seconds")
       ->check(CLI::Range(0.0, 30.0))->capture_default_str();
   app.add_option("--commit-interval", c.commit_interval,
@@ -75,6 +80,30 @@ void add_limit_options(CLI::App& app, CoordinatorOptions& c) {
       ->check(CLI::PositiveNumber)->capture_default_str()->group(limits);
 }
 
+// Uploads hold an HTTP thread while their body arrives: a minimum rate bounds how long, and slots
+// how many (upload_slots.h); the pool has a thread for each slot beyond --http-threads.
+void add_upload_options(CLI::App& app, ServerOptions& o) {
+  auto* limits = "Limits";
+  app.add_option("--min-upload-rate", o.min_upload_rate,
+                 "bytes/s a request body must average once its first --upload-grace seconds are over (else 408): a "
+                 "body of N bytes has at most grace + N / rate seconds")
+      ->check(CLI::Range(1.0, 1e12))->capture_default_str()->group(limits);
+  app.add_option("--upload-grace", o.upload_grace,
+                 "seconds a request body may take to start arriving, and the longest it may pause (else 408)")
+      ->check(CLI::Range(0.5, 600.0))->capture_default_str()->group(limits);
+  app.add_option("--max-uploads", o.max_uploads, "scene and job uploads received at once, all clients together (else 503)")
+      ->check(CLI::Range(1, 4096))->capture_default_str()->group(limits);
+  app.add_option("--max-uploads-per-client", o.max_uploads_per_client,
+                 "scene and job uploads received at once from one client address (else 503)")
+      ->check(CLI::Range(1, 4096))->capture_default_str()->group(limits);
+  app.add_option("--max-result-uploads", o.max_result_uploads,
+                 "workers' result uploads received at once, in slots of their own (else 503; workers retry)")
+      ->check(CLI::Range(1, 4096))->capture_default_str()->group(limits);
+  app.add_option("--max-result-uploads-per-host", o.max_result_uploads_per_host,
+                 "workers' result uploads received at once from one address (else 503; workers retry)")
+      ->check(CLI::Range(1, 4096))->capture_default_str()->group(limits);
+}
+
 void add_retention_options(CLI::App& app, CoordinatorOptions& c) {
   auto* retention = "Retention";
   app.add_option("--retain-days", c.retain_days,
@@ -104,6 +133,7 @@ int parse_server_args(int argc, char** argv, ServerOptions& o) {
   add_service_options(app, o);
   add_security_options(app, o);
   add_limit_options(app, o.coordinator);
+  add_upload_options(app, o);
   add_retention_options(app, o.coordinator);
   add_logging_options(app, o);
   try {

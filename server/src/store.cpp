@@ -361,6 +361,12 @@ uint64_t Store::leases_issued(uint64_t job) {
   return uint64_t(st.i(0));
 }
 
+uint64_t Store::max_leases_per_unit(uint64_t job) {
+  Stmt st(rd_, "SELECT COALESCE(MAX(n), 0) FROM (SELECT COUNT(*) AS n FROM leases WHERE job = ? GROUP BY pass, tile)");
+  st.bind(int64_t(job)).step();
+  return uint64_t(st.i(0));
+}
+
 std::vector<LeaseRow> Store::open_leases(uint64_t job) {
   Stmt st(rd_,
           "SELECT l.seq, l.tile, l.pass, l.worker FROM leases l WHERE l.job = ? "

@@ -400,8 +400,15 @@
     const text = (id) => $(id).value.trim();
     if (text('job-name')) settings.name = text('job-name');
     if (text('scene-file')) settings.scene_file = text('scene-file');
-    for (const [id, field] of [['width', 'width'], ['height', 'height'], ['spp', 'spp'], ['priority', 'priority']])
-      if (text(id) !== '') settings[field] = Number.parseInt(text(id), 10);
+    // Every field a person sets by hand (docs/api.md, JobRequest); an empty box leaves the default.
+    for (const field of ['width', 'height', 'spp', 'priority', 'seed'])
+      if (text(field) !== '') settings[field] = Number(text(field));
+    if (text('target-error') !== '') settings.target_error = Number(text('target-error'));
+    for (const [id, field] of [['integrator', 'integrator'], ['light-selection', 'light_selection'],
+      ['denoise-mode', 'denoise_mode']])
+      if (text(id)) settings[field] = text(id);
+    if (text('guiding')) settings.guiding = text('guiding') === 'on';
+    if ($('adaptive').checked) settings.adaptive = true;
     if ($('denoise').checked) settings.denoise = true;
     const form = new FormData();
     form.append('settings', new Blob([JSON.stringify(settings)], { type: 'application/json' }), 'settings.json');

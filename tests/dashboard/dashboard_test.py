@@ -38,7 +38,7 @@ try:
     from selenium.common.exceptions import TimeoutException
     from selenium.webdriver.chrome.service import Service
     from selenium.webdriver.common.by import By
-    from selenium.webdriver.support.ui import WebDriverWait
+    from selenium.webdriver.support.ui import Select, WebDriverWait
 except ImportError:
     webdriver = None
 
@@ -192,14 +192,32 @@ def job_row(driver, job_id):
     return driver.execute_script(JOB_ROW_JS, str(job_id))
 
 
-def submit(driver, bundle, name, width, height, spp, denoise=False):
+# The form's choices by element id: (text boxes, selects by value, checkboxes). A job's fields left
+# out are reset to the form's defaults, so each submission says only what it sets.
+FORM_BOXES = ("priority", "seed", "target-error")
+FORM_SELECTS = ("integrator", "light-selection", "guiding", "denoise-mode")
+FORM_CHECKS = ("adaptive", "denoise")
+
+
+def fill_form(driver, choices):
+    for field in FORM_BOXES:
+        driver.find_element(By.ID, field).clear()
+        if field in choices:
+            driver.find_element(By.ID, field).send_keys(str(choices[field]))
+    for field in FORM_SELECTS:
+        Select(driver.find_element(By.ID, field)).select_by_value(choices.get(field, ""))
+    for field in FORM_CHECKS:
+        if driver.find_element(By.ID, field).is_selected() != bool(choices.get(field)):
+            driver.find_element(By.ID, field).click()
+
+
+def submit(driver, bundle, name, width, height, spp, **choices):
     previous = driver.find_element(By.ID, "submit-result").get_attribute("data-job-id")
     for field, value in (("job-name", name), ("width", width), ("height", height), ("spp", spp)):
         box = driver.find_element(By.ID, field)
         box.clear()
         box.send_keys(str(value))
-    if driver.find_element(By.ID, "denoise").is_selected() != denoise:
-        driver.find_element(By.ID, "denoise").click()
+    fill_form(driver, {k.replace("_", "-"): v for k, v in choices.items()})
     driver.find_element(By.ID, "bundle").send_keys(str(bundle))
     driver.find_element(By.ID, "submit-button").click()
 
@@ -314,8 +332,16 @@ def run(args, tmp):
         check(not job_row(driver, long_id)["cancel_visible"], "a cancelled job still has a cancel button")
         print(f"job #{long_id} cancelled from the page")
 
-        # A denoised job (the form's checkbox): once done, the toggle shows its denoised image.
-        dn_id = submit(driver, bundle, "denoised", args.width, args.height, args.spp, denoise=True)
+        # A denoised job with every other choice of the form set too: the job gets each as its field.
+        # Once done, the toggle shows its denoised image.
+        chosen = {"integrator": "path", "light_selection": "power", "guiding": "off", "adaptive": True,
+                  "denoise": True, "denoise_mode": "preview", "seed": 7, "priority": 3, "target_error": 0.5}
+        dn_id = submit(driver, bundle, "denoised", args.width, args.height, args.spp, **chosen)
+        settings = server.job(dn_id)["settings"]
+        expected = dict(chosen, guiding=False)
+        wrong = {k: (settings.get(k), v) for k, v in expected.items() if settings.get(k) != v}
+        check(not wrong, f"the form's choices did not reach the job (got, chose): {wrong}")
+        print(f"job #{dn_id} has the form's settings: {expected}")
         wait_for(driver, args.timeout, f"job #{dn_id} to finish",
                  lambda d: (job_row(d, dn_id) or {}).get("state") == "done")
         check(server.job(dn_id)["denoise_state"] == "done", f"the API says {server.job(dn_id)['denoise_state']}")

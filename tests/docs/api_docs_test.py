@@ -2,9 +2,13 @@
 """Runs the ```sh blocks of docs/api.md, in order, in one bash session, against a real coordinator.
 
 The coordinator has a client and a worker token (read from client.token and worker.token in the
-session's folder, as the docs say) and one local worker, so jobs finish. The session starts with
-$S, $TESSERA_CLIENT_TOKEN and $TESSERA_WORKER_TOKEN set and tessera-server, tessera-worker and
-tessera on PATH; its folder has ../shared beside it, like a checkout, so the docs' paths work.
+session's folder, as the docs say) and one local worker, so jobs finish. The session's folder
+stands in for the repository's root: ../shared beside it, and the build's programs in
+build/server, build/worker and build/cli. The session starts from a clean shell (`env -i`): PATH
+holds only /usr/bin and /bin, HOME an empty folder, and nothing else is set, so every variable
+and PATH entry a command uses must be set by the docs themselves (their "Before you start"
+block), and `set -u` makes a variable they never set an error. The one change to the docs' text:
+the coordinator listens on a free port, so the line that sets S=URL sets that port's URL.
 
 Every curl answer must be 2xx, unless the command carries a `# expect: NNN` comment, which makes
 NNN the one answer accepted. Any other answer, a failing command, a curl example that never ran or
@@ -17,6 +21,7 @@ import argparse
 import base64
 import os
 import re
+import shlex
 import shutil
 import signal
 import subprocess
@@ -35,6 +40,8 @@ CLIENT_TOKEN = "docs-client-7f3a"
 WORKER_TOKEN = "docs-worker-21c9"
 EXPECT = re.compile(r"#\s*expect:\s*(\d{3})\b")
 DOCS_NAME = "docs/api.md"  # in messages; set from --docs
+SYSTEM_PATH = "/usr/bin:/bin"  # a clean shell's PATH; /usr/local/bin could hold an installed tessera
+SETS_S = re.compile(r"^(\s*(?:export\s+)?S=)(https?://[^\s#;]+)")
 
 
 # ---- reading the docs -----------------------------------------------------------------------
@@ -120,7 +127,7 @@ def split_commands(lines, first_line):
 # HASH=$(curl ... | jq -r .hash) work), logs the status with the calling line, and fails (as
 # curl --fail does) on an answer the docs do not expect, which ends the session (set -e).
 PREAMBLE = r'''
-set -eE -o pipefail
+set -eEu -o pipefail
 __doc_log() { printf '%s\t%s\t%s\t%s\t%s\n' "$1" "$2" "$3" "$4" "$5" >> "$DOC_LOG"; }
 __doc_out_file() {  # the file of a -o/--output argument, if any
   local prev=""
@@ -149,8 +156,10 @@ trap '__doc_log error "$LINENO" "$?" 0 "$(printf %s "$BASH_COMMAND" | base64 -w0
 '''
 
 
-def build_script(blocks):
-    """The session as one bash script, and for each of its lines the docs line it came from."""
+def build_script(blocks, url, log, done):
+    """The session as one bash script, and for each of its lines the docs line it came from. The
+    docs' S=URL becomes the coordinator's url; the test's own files are the script's variables,
+    not the environment's."""
     lines, origin = [], []
 
     def emit(text, doc_line=None):
@@ -158,6 +167,12 @@ def build_script(blocks):
             lines.append(t)
             origin.append(doc_line)
 
+    sets_s = [(b, i) for b in blocks for i, text in enumerate(b.lines) if SETS_S.match(text)]
+    if not sets_s:
+        raise Failure(f"{DOCS_NAME} never sets S=URL in a ```sh block: its examples' $S would be unset")
+    block, i = sets_s[0]
+    block.lines[i] = SETS_S.sub(lambda m: m.group(1) + url, block.lines[i])
+    emit(f"DOC_LOG={shlex.quote(str(log))} DOC_DONE={shlex.quote(str(done))}")
     emit(PREAMBLE.strip("\n"))
     expect_at = len(lines)
     emit("")  # the DOC_EXPECT table goes here once every line's place is known
@@ -283,24 +298,25 @@ def run(args, tmp):
     blocks = sh_blocks(docs.read_text())
     if not blocks:
         raise Failure(f"{docs} has no ```sh blocks")
-    script, origin = build_script(blocks)
     folder = tmp / "work"  # a stand-in for the repository's root: ../shared sits beside it
     folder.mkdir()
     (tmp / "shared").symlink_to(Path(args.shared).resolve())
+    for part, binary in (("server", args.server), ("worker", args.worker), ("cli", args.cli)):
+        (folder / "build" / part).mkdir(parents=True)
+        (folder / "build" / part / Path(binary).name).symlink_to(binary)
     (folder / "client.token").write_text(CLIENT_TOKEN + "\n")
     (folder / "worker.token").write_text(WORKER_TOKEN + "\n")
-    (tmp / "session.sh").write_text(script)
+    (tmp / "home").mkdir()
     log, done = tmp / "session.log", tmp / "session.done"
 
     server = Coordinator(args, folder)
     try:
-        binaries = {str(Path(p).resolve().parent) for p in (args.server, args.worker, args.cli)}
-        env = dict(os.environ, S=server.url, TESSERA_CLIENT_TOKEN=CLIENT_TOKEN, TESSERA_WORKER_TOKEN=WORKER_TOKEN,
-                   DOC_LOG=str(log), DOC_DONE=str(done), PATH=os.pathsep.join(sorted(binaries)) + os.pathsep +
-                   os.environ.get("PATH", ""))
-        env.pop("TESSERA_SERVER", None)
+        script, origin = build_script(blocks, server.url, log, done)
+        (tmp / "session.sh").write_text(script)
+        env = {"PATH": SYSTEM_PATH, "HOME": str(tmp / "home")}  # env -i: what the docs set, nothing else
         t0 = time.monotonic()
-        session = subprocess.Popen(["bash", str(tmp / "session.sh")], cwd=folder, env=env, stdout=subprocess.PIPE,
+        bash = shutil.which("bash", path=SYSTEM_PATH)
+        session = subprocess.Popen([bash, str(tmp / "session.sh")], cwd=folder, env=env, stdout=subprocess.PIPE,
                                    stderr=subprocess.STDOUT, start_new_session=True)
         try:
             output, _ = session.communicate(timeout=args.timeout)
@@ -348,7 +364,12 @@ def main():
         setattr(args, name, str(Path(getattr(args, name)).resolve()))
 
     ci = os.environ.get("CI") == "true"
-    missing = [f"{t} (scripts/install-deps.sh installs it)" for t in TOOLS if shutil.which(t) is None]
+    missing = [f"{t} in {SYSTEM_PATH} (scripts/install-deps.sh installs it)" for t in TOOLS
+               if shutil.which(t, path=SYSTEM_PATH) is None]
+    for name in ("tessera-server", "tessera-worker", "tessera"):
+        installed = shutil.which(name, path=SYSTEM_PATH)
+        if installed:
+            print(f"note: {installed} is installed, so the docs could lack their PATH line unnoticed")
     if not Path(args.shared, "scenes", "cornell-box", "scene.xml").is_file():
         missing.append(f"{args.shared}/scenes/cornell-box (../shared beside the checkout)")
     if missing:

@@ -19,7 +19,7 @@ import sys
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SCHEMAS = json.load(open(os.path.join(ROOT, "docs", "openapi.json"), encoding="utf-8"))["components"]["schemas"]
 # `tessera submit` options that are the client's, not fields of the job.
-CLIENT_OPTIONS = {"help", "server", "token-file", "ca-file", "output", "wait", "quiet", "D"}
+CLIENT_OPTIONS = {"help", "server", "token-file", "ca-file", "output", "wait", "force", "quiet", "D"}
 
 
 def read(*parts):

@@ -38,8 +38,9 @@ def closed(node):
 
 
 SPEC = closed(json.load(open(os.path.join(ROOT, "docs", "openapi.json"), encoding="utf-8")))
-# Statuses any request can get before it reaches a route (auth.cpp, http_api.cpp).
-BEFORE_ROUTING = {"401", "404", "411", "413"}
+# Statuses any request can get before it reaches a route (auth.cpp, http_admission.cpp; 408: a body
+# that stopped arriving, connection_guard.cpp).
+BEFORE_ROUTING = {"401", "404", "408", "411", "413"}
 # What the farm's tests exercise at the least: the client's and the worker's whole round trip.
 MUST_SEE = ["getHealth", "uploadScene", "submitJob", "listJobs", "getJobStatus", "getJobImage", "cancelJob",
             "registerWorker", "listWorkers", "leaseWork", "sendHeartbeat", "uploadResult", "signOffWorker",

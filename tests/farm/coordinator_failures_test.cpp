@@ -117,7 +117,9 @@ TEST(CoordinatorFailures, AHeldLeaseNobodyClaimsIsReissuedAfterTheBound) {
 TEST(CoordinatorFailures, IdleWorkersGetOneCopyOfTheLastUnitAndTheFirstResultWins) {
   TempDir dir;
   TinyScene tiny;
-  Coordinator c(fast(dir, /*speculate=*/true));
+  server::CoordinatorOptions o = fast(dir, /*speculate=*/true);
+  o.speculate_after = 0;
+  Coordinator c(o);
   const uint64_t a = add_worker(c, "a"), b = add_worker(c, "b"), d = add_worker(c, "d");
   const uint64_t id = submit(c, json{{"tile_size", 64}, {"spp", 1}, {"seed", 5}}, bundle()).value.jobs.at(0).id;
   nlohmann::json la = lease_json(c.lease(a, 0));
@@ -138,6 +140,70 @@ TEST(CoordinatorFailures, IdleWorkersGetOneCopyOfTheLastUnitAndTheFirstResultWin
   EXPECT_EQ(st["duplicate_results"], 1);
   EXPECT_EQ(st["mismatched_results"], 0) << "the same unit renders the same bits";
   EXPECT_NE(c.metrics().find("tessera_passes_total{event=\"speculative\"} 1"), std::string::npos);
+}
+
+// Renders a leased unit as the worker reporting `seconds` of render time would.
+std::string render_unit_taking(const json& lease_json, const Scene& scene, double seconds) {
+  Lease lease;
+  std::string error;
+  EXPECT_TRUE(lease_from_json(lease_json, lease, error)) << error;
+  lease.settings.seed = 5;
+  TileResult result = render_lease(scene, lease);
+  result.seconds = seconds;
+  return encode_tile_result(result);
+}
+
+TEST(CoordinatorFailures, AUnitWhoseResultIsInIsNeverCopiedWhileItsOtherCopyIsOut) {
+  TempDir dir;
+  TinyScene tiny;
+  server::CoordinatorOptions o = fast(dir, /*speculate=*/true, /*interval=*/2);
+  o.speculate_after = 0;
+  Coordinator c(o);
+  std::vector<uint64_t> w;
+  for (const char* name : {"a", "b", "d", "e", "f", "g", "h"}) w.push_back(add_worker(c, name));
+  const uint64_t id = submit(c, json{{"tile_size", 10}, {"spp", 1}, {"seed", 5}}, bundle()).value.jobs.at(0).id;
+  std::vector<json> first;
+  for (int i = 0; i < 4; ++i) first.push_back(lease_json(c.lease(w[i], 0)));  // the job's 4 units
+  json copy = lease_json(c.lease(w[4], 0));
+  ASSERT_TRUE(copy.is_object());
+  EXPECT_EQ(copy["tile"], first[0]["tile"]) << "a copy of the oldest lease";
+  ASSERT_TRUE(c.upload_result(w[4], copy["id"], render_unit(copy, tiny.scene(), 5)).value.accepted);
+  // The unit is in while its first lease is still out: the next idle worker gets another unit.
+  json next = lease_json(c.lease(w[5], 0));
+  ASSERT_TRUE(next.is_object());
+  EXPECT_NE(next["tile"], first[0]["tile"]) << "an accepted unit leased again";
+  json another = lease_json(c.lease(w[6], 0));
+  if (another.is_object()) {
+    EXPECT_NE(another["tile"], first[0]["tile"]);
+  }
+  for (int i = 1; i < 4; ++i) (void)c.upload_result(w[i], first[i]["id"], render_unit(first[i], tiny.scene(), 5));
+  json st = to_json(c.job_status(id).value);
+  EXPECT_EQ(st["state"], "done");
+  EXPECT_EQ(st["reissued_acknowledged_passes"], 0);
+  EXPECT_EQ(st["max_leases_per_unit"], 2);
+  EXPECT_NE(c.metrics().find("tessera_max_leases_per_unit 2"), std::string::npos);
+}
+
+TEST(CoordinatorFailures, ACopyOnlyForAnIdleWorkerAndALeaseOverTheJobsMedianUnitTime) {
+  TempDir dir;
+  TinyScene tiny;
+  server::CoordinatorOptions o = fast(dir, /*speculate=*/true, /*interval=*/2);
+  o.speculate_after = 3;
+  Coordinator c(o);
+  const uint64_t a = add_worker(c, "a"), b = add_worker(c, "b"), d = add_worker(c, "d"), e = add_worker(c, "e");
+  (void)submit(c, json{{"tile_size", 10}, {"spp", 1}, {"seed", 5}}, bundle());
+  json u1 = lease_json(c.lease(a, 0));
+  ASSERT_TRUE(u1.is_object());
+  ASSERT_TRUE(c.upload_result(a, u1["id"], render_unit_taking(u1, tiny.scene(), 0.1)).value.accepted);
+  // The median unit time is 0.1 s: a lease is overdue after 0.3 s.
+  json u2 = lease_json(c.lease(a, 0)), u3 = lease_json(c.lease(b, 0)), u4 = lease_json(c.lease(e, 0));
+  ASSERT_TRUE(u2.is_object() && u3.is_object() && u4.is_object());
+  EXPECT_FALSE(c.lease(d, 0).value.has_value()) << "no lease is overdue yet";
+  sleep_seconds(0.5);
+  EXPECT_FALSE(c.lease(b, 0).value.has_value()) << "a worker holding a lease is not idle";
+  json copy = lease_json(c.lease(d, 0));
+  ASSERT_TRUE(copy.is_object()) << "an idle worker gets a copy of an overdue unit";
+  EXPECT_NE(copy["tile"], u1["tile"]);
 }
 
 TEST(CoordinatorFailures, AResultCarriesTheNextLeaseAndItsRetryIsAnsweredAsTheFirstTime) {
@@ -168,7 +234,9 @@ TEST(CoordinatorFailures, AResultCarriesTheNextLeaseAndItsRetryIsAnsweredAsTheFi
 TEST(CoordinatorFailures, ALaterResultThatDiffersIsCountedAsAMismatch) {
   TempDir dir;
   TinyScene tiny;
-  Coordinator c(fast(dir, true));
+  server::CoordinatorOptions o = fast(dir, true);
+  o.speculate_after = 0;  // (a copy at once)
+  Coordinator c(o);
   const uint64_t a = add_worker(c, "a"), b = add_worker(c, "b");
   const uint64_t id = submit(c, json{{"tile_size", 64}, {"spp", 1}, {"seed", 5}}, bundle()).value.jobs.at(0).id;
   json la = lease_json(c.lease(a, 0)), lb = lease_json(c.lease(b, 0));

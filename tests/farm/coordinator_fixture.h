@@ -52,8 +52,9 @@ inline server::Result<JobSubmission> submit(server::Coordinator& c, const nlohma
                                             const std::string& bundle) {
   JobRequest request;
   std::string error;
-  if (!job_request_from_json(settings, request, error, bundle.empty()))
-    return server::make_error(server::Code::BadRequest, "bad_settings", error);
+  bool out_of_range = false;
+  if (!job_request_from_json(settings, request, error, bundle.empty(), &out_of_range))
+    return server::make_error(out_of_range ? server::Code::Unprocessable : server::Code::BadRequest, "bad_settings", error);
   return c.submit_job(request, bundle);
 }
 

@@ -159,5 +159,45 @@ TEST(DenoiseJob, AJobWithoutDenoiseHasNoDenoisedImage) {
   EXPECT_TRUE(c.job_image(id, "exr").ok());
 }
 
+// `aovs` and `denoise_mode`, as `tessera render --aovs/--denoise-mode`: the EXR carries exactly the
+// layers asked for (render()'s, bit for bit), with or without denoising, read from the film while
+// its image is being written and from disk after; the denoised image is the mode's.
+TEST(DenoiseJob, AJobsAovLayersAndDenoiseModeAreRendersOwn) {
+  TempDir dir;
+  LoadResult loaded = load_fixture_scene();
+  Coordinator c(options(dir));
+  const uint64_t worker = add_worker(c, "w");
+  RenderSettings rs;
+  rs.spp = kSpp;
+  rs.seed = kSeed;
+  rs.aovs = true;
+  const Film film = render(*loaded.scene, rs);
+  const std::string path = (dir.path / "job.exr").string();
+  for (const bool denoised : {false, true}) {
+    json settings = {{"spp", kSpp}, {"tile_size", 8}, {"seed", kSeed}, {"aovs", "albedo,depth"}};
+    if (denoised) settings.update(json{{"denoise", true}, {"denoise_mode", "preview"}});
+    auto job = submit(c, settings, bundle());
+    ASSERT_TRUE(job.ok()) << job.status.detail;
+    const uint64_t id = job.value.jobs.at(0).id;
+    while (deliver_one(c, worker, *loaded.scene, kSeed)) {
+    }
+    ASSERT_EQ(wait_done(c, id).value.state, "done");
+    auto bytes = c.job_image(id, "exr");
+    ASSERT_TRUE(bytes.ok()) << bytes.status.detail;
+    std::ofstream(path, std::ios::binary) << bytes.value.bytes;
+    EXPECT_EQ(read_exr(path).values(), film.to_image().values());
+    for (AovLayer l : {AovLayer::Albedo, AovLayer::Depth})
+      EXPECT_EQ(read_exr_layer(path, aov_layer_name(l), aov_channel_names(l)).values(),
+                film.aov_layers({l}).at(0).image.values())
+          << aov_layer_name(l);
+    EXPECT_THROW(read_exr_layer(path, "normal", aov_channel_names(AovLayer::Normal)), std::exception) << "not asked for";
+    if (!denoised) continue;
+    DenoiseSettings preview;
+    preview.mode = DenoiseMode::Preview;
+    const Image expected = denoise(make_denoise_input(film.to_image(), film.aov_layers(denoise_layers())), preview);
+    EXPECT_EQ(job_exr(c, id, true, dir).color.values(), expected.values()) << "the preview mode's denoised image";
+  }
+}
+
 }  // namespace
 }  // namespace tessera::test

@@ -50,6 +50,15 @@ TEST_F(FarmApi, MalformedJsonUnknownFieldsAndAbsurdSizes) {
   EXPECT_NE(detail.find("'spp'"), std::string::npos) << detail;
   detail = expect_error(c.post_json("/api/v1/jobs", json{{"scene", std::string(64, 'a')}, {"width", 1000000}}), 422);
   EXPECT_NE(detail.find("width"), std::string::npos) << detail;
+  // A number out of its field's range is a 422 naming the field and the range, however far out.
+  const std::string scene = "{\"scene\": \"" + std::string(64, 'a') + "\", ";
+  for (const char* spp : {"18446744073709551616", "-5", "2.5", "1e40"}) {
+    detail = expect_error(c.post_bytes("/api/v1/jobs", scene + "\"spp\": " + spp + "}", "application/json"), 422);
+    EXPECT_NE(detail.find("spp"), std::string::npos) << detail;
+    EXPECT_NE(detail.find(".."), std::string::npos) << "no range in: " << detail;
+  }
+  detail = expect_error(c.post_bytes("/api/v1/jobs", scene + "\"seed\": -1}", "application/json"), 422);
+  EXPECT_NE(detail.find("'seed' must be an integer in 0..4294967295"), std::string::npos) << detail;
   expect_error(c.post_json("/api/v1/jobs", json{{"scene", std::string(64, 'a')}}), 404);  // no such bundle
   expect_error(c.post_json("/api/v1/jobs", json::array({1, 2})), 400);
   expect_error(c.get("/api/v1/jobs/999"), 404);

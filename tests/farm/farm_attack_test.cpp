@@ -80,8 +80,11 @@ TEST(FarmAttack, EveryAttackIsRefusedAndAcceptedWorkSurvives) {
   // 2. Oversized bodies: a bundle over --max-upload, a body over the transport's limit.
   tally.expect_refused(http.post_bytes("/api/v1/scenes", noise(2100000, 1), "application/gzip").status == 413,
                        "bundle over --max-upload");
-  tally.expect_refused(is_refusal(http.post_bytes("/api/v1/jobs", std::string(40u << 20, '{'), "application/json", 60).status),
-                       "40 MB JSON body");
+  // (Refused from its headers and closed unread: the client may meet the closed connection, 0,
+  // before it reads the 413. Its write must then not end this test with a SIGPIPE.)
+  ::signal(SIGPIPE, SIG_IGN);
+  const int json_40mb = http.post_bytes("/api/v1/jobs", std::string(40u << 20, '{'), "application/json", 60).status;
+  tally.expect_refused(is_refusal(json_40mb) || json_40mb == 0, "40 MB JSON body");
 
   // 3. Hostile bundles.
   const std::vector<std::pair<std::string, std::string>> bundles = {
@@ -274,14 +277,14 @@ TEST(FarmAttack, HttpEdgeCasesAreAnsweredProperly) {
   EXPECT_EQ(as_form.json().value("hash", ""), sha256_hex(bundle));
 
   // Every 413 names the limit and its flag: a bundle over --max-upload (the coordinator's check)
-  // and a body over what the transport reads at all (cpp-httplib's); a chunked body, whose size
+  // and a body over what is read at all (refused from its headers); a chunked body, whose size
   // the transport would not bound, is refused with 411.
   const client::HttpReply big = http.post_bytes("/api/v1/scenes", noise(200000, 4), "application/gzip");
   EXPECT_EQ(big.status, 413);
   EXPECT_NE(big.body.find("--max-upload"), std::string::npos) << big.body;
-  const std::string body(17u << 20, 'x');
-  const std::string huge = raw_reply(
-      port, curl_like("POST", "/api/v1/scenes", client_auth + "Content-Length: " + std::to_string(body.size()) + "\r\n", body), 20);
+  // (The 413 comes from the headers alone: the body is never read, so none is sent.)
+  const std::string huge =
+      raw_reply(port, curl_like("POST", "/api/v1/scenes", client_auth + "Content-Length: " + std::to_string(17u << 20) + "\r\n"), 20);
   EXPECT_EQ(status_of(huge), 413) << huge;
   EXPECT_NE(huge.find("16877216 bytes (tessera-server --max-upload 100000"), std::string::npos) << huge;
   EXPECT_EQ(raw_status(port, curl_like("POST", "/api/v1/scenes", client_auth + "Transfer-Encoding: chunked\r\n", "5\r\nhello\r\n0\r\n\r\n"), 5),

@@ -143,6 +143,36 @@ TEST(FarmIntegration, KilledCoordinatorResumesWithoutRerenderingAcknowledgedPass
               st.value("leases_issued", 0), st.value("reissued_acknowledged_passes", -1));
 }
 
+// Speculation bounded by construction, end to end: a denoised job of 150 units on two workers, one
+// killed at 30% and the coordinator killed and restarted at 60%, costs at most 1.2 leases a unit,
+// never more than two of one unit, and nothing acknowledged is leased again (bench/speculation.sh
+// measures the same).
+TEST(FarmIntegration, KillsCostFewLeasesAndNothingAcknowledgedIsLeasedAgain) {
+  TESSERA_REQUIRE_FILE(cornell());
+  Farm farm({"--heartbeat-interval", "0.5"});
+  ASSERT_TRUE(start_with_two_workers(farm));
+  JobSettings settings = long_job();
+  settings.spp = 37;  // passes 1,2,4,8,16,6
+  settings.width = settings.height = 200;
+  settings.tile_size = 40;  // 25 tiles: 150 units
+  settings.denoise = true;
+  const uint64_t id = farm.submit(cornell(), settings);
+  ASSERT_GT(id, 0u);
+  farm.wait_until(id, [](const nlohmann::json& j) { return progress(j) >= 0.3; });
+  farm.worker(0).kill_now();
+  farm.wait_until(id, [](const nlohmann::json& j) { return progress(j) >= 0.6; });
+  farm.kill_server();
+  farm.start_server();
+  const nlohmann::json st = farm.wait_job(id);
+  ASSERT_EQ(st.value("state", ""), "done") << st.dump(2);
+  ASSERT_EQ(st.value("units_total", 0), 150);
+  EXPECT_LE(st.value("leases_issued", 1000), 180) << "more than 1.2 leases a unit";
+  EXPECT_LE(st.value("max_leases_per_unit", 100), 2);
+  EXPECT_EQ(st.value("reissued_acknowledged_passes", -1), 0);
+  std::printf("%d leases for %d units, at most %d of one, %d acknowledged re-issued\n", st.value("leases_issued", 0),
+              st.value("units_total", 0), st.value("max_leases_per_unit", 0), st.value("reissued_acknowledged_passes", -1));
+}
+
 // Adaptive passes open at barriers whose counts the coordinator stores before leasing them: killed
 // inside one, it resumes with the same counts, and the image is `tessera render --adaptive on`'s.
 TEST(FarmIntegration, AdaptiveJobSurvivesAKilledCoordinatorBitForBit) {

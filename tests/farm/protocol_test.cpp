@@ -43,6 +43,49 @@ TEST(Protocol, JobSettingsRoundTrip) {
   EXPECT_EQ(back.guiding, std::optional<bool>(false));
 }
 
+// A number its field cannot hold is out of range (the API's 422, as the limits), named with the
+// range, whether it is negative, a fraction or beyond any JSON integer; a wrong type stays a
+// malformed request (400).
+TEST(Protocol, OutOfRangeNumbersNameTheFieldAndItsRange) {
+  const std::string h(64, 'a');
+  const auto range_error = [&](const std::string& body) {
+    JobSettings s;
+    std::string error;
+    bool out_of_range = false;
+    EXPECT_FALSE(job_settings_from_json(json::parse(body), s, error, true, &out_of_range)) << body;
+    EXPECT_TRUE(out_of_range) << body << ": " << error;
+    return error;
+  };
+  const std::string pre = "{\"scene\": \"" + h + "\", ";
+  EXPECT_NE(range_error(pre + "\"spp\": 18446744073709551616}").find("'spp' must be an integer in -2147483648..2147483647"),
+            std::string::npos);
+  EXPECT_NE(range_error(pre + "\"spp\": 9223372036854775808}").find("'spp'"), std::string::npos);
+  EXPECT_NE(range_error(pre + "\"spp\": 2.5}").find("'spp' must be an integer in"), std::string::npos);
+  EXPECT_NE(range_error(pre + "\"seed\": -1}").find("'seed' must be an integer in 0..4294967295, not -1"), std::string::npos);
+  EXPECT_NE(range_error(pre + "\"priority\": 1e30}").find("'priority'"), std::string::npos);
+  EXPECT_NE(range_error(pre + "\"target_error\": 2}").find("'target_error' must be a relMSE in 0..1"), std::string::npos);
+  JobSettings s;
+  std::string error;
+  bool out_of_range = true;
+  EXPECT_FALSE(job_settings_from_json(json{{"scene", h}, {"spp", "many"}}, s, error, true, &out_of_range));
+  EXPECT_FALSE(out_of_range) << "a string is malformed, not out of range";
+  JobRequest request;
+  std::string frames_error;
+  EXPECT_FALSE(job_request_from_json(json::parse(pre + "\"frames\": \"1-2\", \"spp\": 2.5}"), request, frames_error,
+                                     true, &out_of_range));
+  EXPECT_TRUE(out_of_range) << "a frame range's settings are told apart alike";
+}
+
+// Every shared scene is scene.xml: an unnamed job is named after its folder.
+TEST(Protocol, DefaultJobNameIsTheScenesFolder) {
+  EXPECT_EQ(default_job_name("/scenes/cornell-box/scene.xml"), "cornell-box");
+  EXPECT_EQ(default_job_name("cornell-box/scene.xml"), "cornell-box");
+  EXPECT_EQ(default_job_name("/scenes/veach/mis.xml"), "veach-mis");
+  EXPECT_EQ(default_job_name("/scenes/kitchen/kitchen.xml"), "kitchen");
+  EXPECT_EQ(default_job_name("scene.xml"), "scene");
+  EXPECT_EQ(default_job_name("cbox.xml"), "cbox");
+}
+
 TEST(Protocol, JobSettingsAreStrict) {
   const std::string h(64, 'a');
   EXPECT_NE(parse_error(json{{"scene", h}, {"spp_", 3}}).find("unknown field 'spp_'"), std::string::npos);
@@ -189,7 +232,7 @@ TEST(Protocol, HeartbeatsRoundTripAndAreStrict) {
   refused(json::array(), "expected a JSON object");
   refused(json{{"leases", json::array()}, {"junk", 1}}, "unknown field 'junk'");
   refused(json{{"leases", "x"}}, "'leases' must be an array");
-  refused(json{{"memory", {{"scene_bytes", -1}, {"scenes", 0}}}}, "'scene_bytes' must be an integer in range");
+  refused(json{{"memory", {{"scene_bytes", -1}, {"scenes", 0}}}}, "'scene_bytes' must be an integer in 0..");
   refused(json{{"memory", {{"scenes", 1}}}}, "missing field 'scene_bytes'");
   refused(json{{"leases", {{{"id", 1}, {"job", 1}, {"tile", 0}}}}}, "missing field 'pass'");
   refused(json{{"leases", {{{"id", -1}, {"job", 1}, {"tile", 0}, {"pass", 0}}}}}, "field 'id'");

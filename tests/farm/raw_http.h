@@ -16,12 +16,17 @@ namespace tessera::test {
 
 class RawConnection {
  public:
-  explicit RawConnection(int port) : fd_(::socket(AF_INET, SOCK_STREAM, 0)) {
+  /// To 127.0.0.1:port, from `source` (another loopback address, e.g. "127.0.0.2": another client).
+  explicit RawConnection(int port, const char* source = nullptr) : fd_(::socket(AF_INET, SOCK_STREAM, 0)) {
     sockaddr_in a{};
     a.sin_family = AF_INET;
     a.sin_port = htons(uint16_t(port));
     a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    connected_ = fd_ >= 0 && ::connect(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
+    sockaddr_in from{};
+    from.sin_family = AF_INET;
+    const bool bound = !source || (::inet_pton(AF_INET, source, &from.sin_addr) == 1 &&
+                                    ::bind(fd_, reinterpret_cast<sockaddr*>(&from), sizeof from) == 0);
+    connected_ = fd_ >= 0 && bound && ::connect(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
   }
   ~RawConnection() {
     if (fd_ >= 0) ::close(fd_);

@@ -37,7 +37,7 @@ WorkerOptions resolve_worker_options(WorkerOptions o) {
 }
 
 Worker::Worker(WorkerOptions options)
-    : opt_(resolve_worker_options(std::move(options))), api_(client::FarmClient(opt_.server, opt_.token, opt_.ca_file)), cache_(opt_.cache_dir, opt_.memory_budget) {}
+    : opt_(resolve_worker_options(std::move(options))), api_(client::FarmClient(opt_.server, opt_.token, opt_.ca_file)), cache_lock_(opt_.cache_dir), cache_(opt_.cache_dir, opt_.memory_budget) {}
 
 void Worker::backoff(int& attempt, bool interruptible) {
   // 0.25 s doubling to 8 s, in small steps so a stop request is seen at once.

@@ -10,6 +10,7 @@
 #include <signal.h>
 
 #include <cstdio>
+#include <optional>
 #include <thread>
 
 namespace tessera::farm {
@@ -22,7 +23,7 @@ int worker_main(int argc, char** argv) {
   app.add_option("--ca-file", o.ca_file, "PEM file to verify an https coordinator's certificate (default: system CAs)")
       ->check(CLI::ExistingFile);
   app.add_option("--threads", o.threads, "render threads (default: every core)")->check(CLI::Range(0, 4096));
-  app.add_option("--cache-dir", o.cache_dir, "where scene bundles are kept (default: ~/.cache/tessera-worker)");
+  app.add_option("--cache-dir", o.cache_dir, "where scene bundles are kept, one worker per folder (default: ~/.cache/tessera-worker)");
   app.add_option("--name", o.name, "name shown by the coordinator (default: host name)");
   app.add_option("--memory-budget", budget_mb, "MB of loaded scenes kept in memory (default: half the RAM)");
   app.add_option("--poll-wait", o.poll_wait, "seconds per lease long poll")->check(CLI::Range(0.0, 30.0))->capture_default_str();
@@ -61,7 +62,14 @@ int worker_main(int argc, char** argv) {
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   ::signal(SIGPIPE, SIG_IGN);
 
-  Worker worker(o);
+  std::optional<Worker> made;
+  try {
+    made.emplace(o);
+  } catch (const std::exception& e) {  // (its cache folder in use, or not writable)
+    spdlog::error("{}", e.what());
+    return 2;
+  }
+  Worker& worker = *made;
   std::atomic<bool> done{false};
   std::thread signal_thread([&] {
     int count = 0;

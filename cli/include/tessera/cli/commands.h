@@ -63,9 +63,13 @@ struct SubmitOptions {
   std::string guiding;               // "on", "off"; empty: as the scene says
   std::string adaptive = "off";      // adaptive sampling: "on" or "off"
   bool denoise = false;              // outputs get the denoised image, FILE.noisy.ext the raw one
+  std::string denoise_mode = "full"; // "full" or "preview"
+  std::string aovs;                  // AOV layers the EXR outputs carry (render/aov.h); empty: none
+  bool allow_unsupported = false;
   std::string webhook;               // URL the coordinator POSTs the job's status to when it ends
   std::string frames;                // "A-B": one job per frame (-D frame=N); outputs carry ####
-  bool wait = false, quiet = false;
+  bool wait = false, quiet = false;  // quiet: nothing printed but errors
+  bool force = false;                // --wait without -o may overwrite JOBNAME.exr
 };
 
 struct JobsOptions {

@@ -13,11 +13,13 @@ struct HttpReply {
   int status = 0;          // 0: no answer (connection refused, timeout, ...)
   std::string body;
   std::string transport;   // what went wrong when status == 0
+  std::string url;         // the server asked (empty when the failure was local, as a file not written)
   std::map<std::string, std::string> headers;
   bool ok() const { return status >= 200 && status < 300; }
   /// The body as JSON (null if it is not).
   nlohmann::json json() const;
-  /// "HTTP 422 scene_load_failed: <detail>" or the transport error: for messages.
+  /// "HTTP 422 scene_load_failed: <detail>", or with no answer "no answer from URL (why)": for
+  /// messages.
   std::string describe() const;
 };
 

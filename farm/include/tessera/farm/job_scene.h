@@ -7,6 +7,7 @@
 #include "tessera/farm/protocol.h"
 #include "tessera/farm/tile_result.h"
 #include "tessera/guiding/spatial_tree.h"
+#include "tessera/image/image.h"
 #include "tessera/sequence/path_program.h"
 #include "tessera/scene/load_context.h"
 
@@ -58,6 +59,11 @@ JobPlan make_job_plan(const std::string& bundle_dir, const std::string& scene_fi
 
 /// Sets `out` to the lease's unit (job, tile, pass, samples) with a zero film of its rectangle,
 /// reusing its storage: a result about to be filled.
+/// The image layers the job's EXR carries (as `tessera render --aovs/--denoise` writes them): those
+/// of `aovs`, else with `denoise` every layer the denoiser reads, else none. Keeps, in `layers`,
+/// only those.
+void keep_job_exr_layers(const JobSettings& settings, std::vector<ImageLayer>& layers);
+
 void begin_tile_result(const Lease& lease, TileResult& out);
 /// Renders a lease's unit (what a worker does with it), timed. A guided lease needs its guide
 /// (Lease::guide, decoded): a unit that trains returns its training records with the result.

@@ -50,7 +50,7 @@ struct JobStatus {
   /// job is done with its raw image).
   std::string denoise_state, denoise_error;
   // From the lease log; absent when it could not be read.
-  std::optional<uint64_t> leases_issued, reissued_acknowledged_passes;
+  std::optional<uint64_t> leases_issued, max_leases_per_unit, reissued_acknowledged_passes;
 };
 
 nlohmann::json to_json(const JobStatus& s);

@@ -39,8 +39,22 @@ struct JobSettings {
   /// Denoise the finished image (denoise/denoiser.h): units render the AOV sums too, and the job is
   /// done once the raw image (with its AOV layers) and the denoised one are stored.
   bool denoise = false;
+  std::string denoise_mode;     // "full" or "preview" (denoise/denoiser.h); empty: full
+  /// AOV layers the image's EXR carries beside it (render/aov.h: "albedo,normal", "all"); empty:
+  /// none, or with `denoise` the denoiser's. Units then sum the AOVs too (sums_aovs()).
+  std::string aovs;
+  bool allow_unsupported = false;  // documented fallbacks for unsupported plugins (LoadOptions)
   std::string webhook;          // http(s) URL POSTed the job's status when it ends; empty: none
+
+  /// Whether units render the AOV sums: for the denoiser, or for the layers asked for.
+  bool sums_aovs() const { return denoise || !aovs.empty(); }
 };
+
+/// The name of a job that was not given one: its scene's folder, then the file's stem unless that
+/// is the conventional "scene" (cornell-box/scene.xml -> "cornell-box", veach/mis.xml ->
+/// "veach-mis"); a path without a folder gives the stem. Many scenes are all called scene.xml, so
+/// the stem alone would name every job alike.
+std::string default_job_name(const std::string& scene_path);
 
 /// Limits a job must respect (the coordinator's flags).
 struct JobLimits {
@@ -53,8 +67,10 @@ struct JobLimits {
 
 nlohmann::json to_json(const JobSettings& s);
 /// `j` must be an object; `require_scene` demands the `scene` field (not for multipart uploads).
+/// `out_of_range` (if given) tells a number outside its field's range (the API's 422) from a
+/// malformed request (400); the error names the field and the range.
 [[nodiscard]] bool job_settings_from_json(const nlohmann::json& j, JobSettings& out, std::string& error,
-                                          bool require_scene = true);
+                                          bool require_scene = true, bool* out_of_range = nullptr);
 
 /// A submission: the job's settings and, for an animation, its inclusive frame range (one job per
 /// frame N, with `-D frame=N`).
@@ -64,7 +80,7 @@ struct JobRequest {
 };
 /// The settings plus "frames": "FIRST-LAST", "FIRST..LAST", a frame number or [FIRST, LAST].
 [[nodiscard]] bool job_request_from_json(const nlohmann::json& j, JobRequest& out, std::string& error,
-                                         bool require_scene = true);
+                                         bool require_scene = true, bool* out_of_range = nullptr);
 
 /// Range checks after the scene's defaults are known.
 [[nodiscard]] bool check_job_limits(const JobSettings& s, const JobLimits& limits, std::string& error);

@@ -38,9 +38,12 @@ struct CoordinatorOptions {
   // at a time, off its lock; the image does not depend on it. 0: every core.
   int denoise_threads = 1;
   int max_waiting_polls = 16;     // concurrent long polls; more get 204 at once (never starve clients)
-  // Idle workers get a copy of a job's oldest outstanding unit once it has no unleased one
+  // Idle workers get a copy of a job's oldest overdue unit once it has no unleased one
   // (scheduler.h); the first result wins and a later one must match it bit for bit.
   bool speculate = true;
+  // A lease is overdue once it has run this many times the job's median unit render time (and
+  // only once one unit of the job is in); 0: at once.
+  double speculate_after = 3;
   int worker_failure_limit = 2;   // failures of one worker on one job before it is kept off the job
   int failed_workers_limit = 3;   // distinct workers failing a job before the job fails
   JobLimits limits;

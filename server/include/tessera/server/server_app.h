@@ -18,6 +18,12 @@ struct ServerOptions {
   std::string client_token, client_token_file, worker_token, worker_token_file;  // auth.h
   std::string tls_cert, tls_key;          // PEM files; both set: serve https only
   double header_timeout = 10;             // seconds a connection may take to send a request's headers
+  double min_upload_rate = 65536;         // bytes/s a body must average after its grace (else 408)
+  double upload_grace = 10;               // seconds a body may take to start, and its longest pause
+  int max_uploads = 16;                   // bundles (scenes, jobs) received at once, all clients
+  int max_uploads_per_client = 4;         // ... from one client address
+  int max_result_uploads = 32;            // workers' results received at once, all workers
+  int max_result_uploads_per_host = 16;   // ... from one address
   std::string log_format = "text";        // text or json (one JSON object per line)
   std::string log_level = "info";         // debug shows every lease; info every job state change
   std::string record_responses;           // file: every answer, a JSON line each (response_recorder.h)

@@ -127,6 +127,8 @@ class Store {
   /// restart test reads).
   uint64_t reissued_after_ack(uint64_t job);
   uint64_t leases_issued(uint64_t job);
+  /// The most leases logged for any one unit of the job.
+  uint64_t max_leases_per_unit(uint64_t job);
   /// Each unit's newest lease when the unit has no result: the work in flight when the previous
   /// process stopped.
   std::vector<LeaseRow> open_leases(uint64_t job);

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "tessera/client/farm_api.h"
+#include "tessera/farm/cache_lock.h"
 #include "tessera/worker/scene_cache.h"
 
 #include <atomic>
@@ -56,6 +57,7 @@ class Worker {
 
   WorkerOptions opt_;
   client::FarmApi api_;
+  CacheLock cache_lock_;  // (before the cache: one worker per cache folder)
   SceneCache cache_;
   std::atomic<bool> stop_{false}, refused_{false};
   std::atomic<uint64_t> worker_id_{0};
