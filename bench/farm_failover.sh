@@ -13,14 +13,7 @@ spp=${3:-64}
 size=${4:-128}
 read -r -a server_flags <<< "${5:-}"
 scene=../shared/scenes/cornell-box
-tmp=$(mktemp -d)
-pids=()
-cleanup() {
-  for p in "${pids[@]}"; do kill -9 "$p" 2>/dev/null || true; done
-  wait 2>/dev/null || true
-  rm -rf "$tmp"
-}
-trap cleanup EXIT
+source bench/farm_processes.sh
 
 # One run: a fresh coordinator and two 1-thread workers; KILL=1 kills worker 0 at 90%.
 run() {

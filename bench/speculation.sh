@@ -12,14 +12,7 @@ build=${1:-build}
 rounds=${2:-3}
 read -r -a server_flags <<< "${3:-}"
 scene=../shared/scenes/cornell-box
-tmp=$(mktemp -d)
-pids=()
-cleanup() {
-  for p in "${pids[@]}"; do kill -9 "$p" 2>/dev/null || true; done
-  wait 2>/dev/null || true
-  rm -rf "$tmp"
-}
-trap cleanup EXIT
+source bench/farm_processes.sh
 
 start_server() {  # DIR LISTEN
   "$build/server/tessera-server" --listen "$2" --port-file "$1/port" --data-dir "$1/data" \

@@ -13,14 +13,7 @@ build=${1:-build}
 stalled=${2:-200}
 read -r -a server_flags <<< "${3:-}"
 scene=../shared/scenes/cornell-box
-tmp=$(mktemp -d)
-pids=()
-cleanup() {
-  for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
-  wait 2>/dev/null || true
-  rm -rf "$tmp"
-}
-trap cleanup EXIT
+source bench/farm_processes.sh
 
 "$build/server/tessera-server" --listen 127.0.0.1:0 --port-file "$tmp/port" --data-dir "$tmp/data" \
     --local-workers 1 --log-level warn "${server_flags[@]}" > "$tmp/server.log" 2>&1 &

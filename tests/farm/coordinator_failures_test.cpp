@@ -142,17 +142,6 @@ TEST(CoordinatorFailures, IdleWorkersGetOneCopyOfTheLastUnitAndTheFirstResultWin
   EXPECT_NE(c.metrics().find("tessera_passes_total{event=\"speculative\"} 1"), std::string::npos);
 }
 
-// Renders a leased unit as the worker reporting `seconds` of render time would.
-std::string render_unit_taking(const json& lease_json, const Scene& scene, double seconds) {
-  Lease lease;
-  std::string error;
-  EXPECT_TRUE(lease_from_json(lease_json, lease, error)) << error;
-  lease.settings.seed = 5;
-  TileResult result = render_lease(scene, lease);
-  result.seconds = seconds;
-  return encode_tile_result(result);
-}
-
 TEST(CoordinatorFailures, AUnitWhoseResultIsInIsNeverCopiedWhileItsOtherCopyIsOut) {
   TempDir dir;
   TinyScene tiny;
@@ -194,7 +183,7 @@ TEST(CoordinatorFailures, ACopyOnlyForAnIdleWorkerAndALeaseOverTheJobsMedianUnit
   (void)submit(c, json{{"tile_size", 10}, {"spp", 1}, {"seed", 5}}, bundle());
   json u1 = lease_json(c.lease(a, 0));
   ASSERT_TRUE(u1.is_object());
-  ASSERT_TRUE(c.upload_result(a, u1["id"], render_unit_taking(u1, tiny.scene(), 0.1)).value.accepted);
+  ASSERT_TRUE(c.upload_result(a, u1["id"], render_unit(u1, tiny.scene(), 5, /*seconds=*/0.1)).value.accepted);
   // The median unit time is 0.1 s: a lease is overdue after 0.3 s.
   json u2 = lease_json(c.lease(a, 0)), u3 = lease_json(c.lease(b, 0)), u4 = lease_json(c.lease(e, 0));
   ASSERT_TRUE(u2.is_object() && u3.is_object() && u4.is_object());

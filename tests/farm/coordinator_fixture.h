@@ -16,6 +16,7 @@
 #include <cstring>
 #include <fstream>
 #include <functional>
+#include <optional>
 
 namespace tessera::test {
 
@@ -64,13 +65,17 @@ inline server::CoordinatorOptions options(const TempDir& dir) {
   return o;
 }
 
-// Renders a leased unit for real (the scene's seed replaced by `seed`) as a tile result's bytes.
-inline std::string render_unit(const nlohmann::json& lease_json, const Scene& scene, uint32_t seed) {
+// Renders a leased unit for real (the scene's seed replaced by `seed`) as a tile result's bytes;
+// with `seconds`, as a worker reporting that much render time would.
+inline std::string render_unit(const nlohmann::json& lease_json, const Scene& scene, uint32_t seed,
+                               std::optional<double> seconds = std::nullopt) {
   Lease lease;
   std::string error;
   EXPECT_TRUE(lease_from_json(lease_json, lease, error)) << error;
   lease.settings.seed = seed;
-  return encode_tile_result(render_lease(scene, lease));
+  TileResult result = render_lease(scene, lease);
+  if (seconds) result.seconds = *seconds;
+  return encode_tile_result(result);
 }
 
 // Leases and delivers one unit for real; false when there was nothing to lease.
