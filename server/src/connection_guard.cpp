@@ -128,6 +128,7 @@ bool ConnectionGuard::check_body(int fd, const std::string& name, Peer& p, doubl
   // its client has stopped sending on for gone. Over https the bytes would have to be encrypted
   // by httplib's session, so the connection is only closed. The send never blocks: a client that
   // does not read its answer loses it.
+  bodies_cut_off_.fetch_add(1);  // (counted before the client can see its answer)
   if (!limits_.tls) {
     const std::string body = nlohmann::json{{"error", "body_too_slow"}, {"detail", p.timed_out}}.dump(2) + "\n";
     const std::string answer = "HTTP/1.1 408 Request Timeout\r\nContent-Type: application/json\r\nContent-Length: " +
@@ -136,7 +137,6 @@ bool ConnectionGuard::check_body(int fd, const std::string& name, Peer& p, doubl
   }
   ::shutdown(fd, SHUT_RDWR);
   p.in_body = false;
-  bodies_cut_off_.fetch_add(1);
   log_event(spdlog::level::warn, "connection.cut_off",
             {{"peer", name}, {"reason", "body_too_slow"}, {"detail", p.timed_out}});
   return true;
@@ -169,8 +169,8 @@ void ConnectionGuard::scan(double now) {
     if (p.in_request || now - p.since <= limits_.header_timeout) continue;
     // Still the same socket (the descriptor may have been closed and reused since readlink)?
     if (socket_inode(fd) != inode) continue;
-    ::shutdown(fd, SHUT_RDWR);
     cut_off_.fetch_add(1);
+    ::shutdown(fd, SHUT_RDWR);
     log_event(spdlog::level::warn, "connection.cut_off", {{"peer", peer}, {"header_timeout", limits_.header_timeout}});
     p.since = now + 3600;  // once is enough; httplib closes it now
   }
