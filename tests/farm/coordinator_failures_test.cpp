@@ -183,12 +183,12 @@ TEST(CoordinatorFailures, ACopyOnlyForAnIdleWorkerAndALeaseOverTheJobsMedianUnit
   (void)submit(c, json{{"tile_size", 10}, {"spp", 1}, {"seed", 5}}, bundle());
   json u1 = lease_json(c.lease(a, 0));
   ASSERT_TRUE(u1.is_object());
-  ASSERT_TRUE(c.upload_result(a, u1["id"], render_unit(u1, tiny.scene(), 5, /*seconds=*/0.1)).value.accepted);
-  // The median unit time is 0.1 s: a lease is overdue after 0.3 s.
+  ASSERT_TRUE(c.upload_result(a, u1["id"], render_unit(u1, tiny.scene(), 5, /*seconds=*/1.0)).value.accepted);
+  // The median unit time is 1 s: a lease is overdue after 3 s.
   json u2 = lease_json(c.lease(a, 0)), u3 = lease_json(c.lease(b, 0)), u4 = lease_json(c.lease(e, 0));
   ASSERT_TRUE(u2.is_object() && u3.is_object() && u4.is_object());
   EXPECT_FALSE(c.lease(d, 0).value.has_value()) << "no lease is overdue yet";
-  sleep_seconds(0.5);
+  sleep_seconds(3.3);
   EXPECT_FALSE(c.lease(b, 0).value.has_value()) << "a worker holding a lease is not idle";
   json copy = lease_json(c.lease(d, 0));
   ASSERT_TRUE(copy.is_object()) << "an idle worker gets a copy of an overdue unit";
