@@ -149,8 +149,10 @@ bool job_settings_from_json(const json& j, JobSettings& out, std::string& error,
 std::string default_job_name(const std::string& scene_path) {
   const std::filesystem::path path(scene_path);
   const std::string stem = path.stem().string(), folder = path.parent_path().filename().string();
-  if (folder.empty() || folder == "." || folder == "..") return stem;
-  return (stem == "scene" || stem == folder ? folder : folder + "-" + stem).substr(0, 200);
+  const std::string name = folder.empty() || folder == "." || folder == ".." ? stem
+                           : stem == "scene" || stem == folder             ? folder
+                                                                            : folder + "-" + stem;
+  return name.substr(0, 200);
 }
 
 bool check_job_limits(const JobSettings& s, const JobLimits& l, std::string& error) {

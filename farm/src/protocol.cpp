@@ -4,10 +4,7 @@
 #include "tessera/farm/sha256.h"
 
 #include <cstdlib>
-#include <filesystem>
 #include <fstream>
-#include <limits>
-#include <set>
 #include <stdexcept>
 
 namespace tessera {

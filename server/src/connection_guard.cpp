@@ -7,6 +7,7 @@
 #include <spdlog/spdlog.h>
 
 #include <dirent.h>
+#include <fcntl.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -142,6 +143,14 @@ bool ConnectionGuard::check_body(int fd, const std::string& name, Peer& p, doubl
   return true;
 }
 
+// Under mu_. A connection whose request headers did not arrive within --header-timeout.
+void ConnectionGuard::cut_off_headers(int fd, const std::string& name, Peer& p, double now) {
+  cut_off_.fetch_add(1);
+  ::shutdown(fd, SHUT_RDWR);
+  log_event(spdlog::level::warn, "connection.cut_off", {{"peer", name}, {"header_timeout", limits_.header_timeout}});
+  p.since = now + 3600;  // once is enough; httplib closes it now
+}
+
 // Under mu_ (the request hooks wait at most one scan of the descriptor table).
 void ConnectionGuard::scan(double now) {
   DIR* dir = opendir("/proc/self/fd");
@@ -165,14 +174,17 @@ void ConnectionGuard::scan(double now) {
     }
     seen.emplace(inode, peer);
     Peer& p = peers_[peer];
-    if (p.in_body && socket_inode(fd) == inode) check_body(fd, peer, p, now);
-    if (p.in_request || now - p.since <= limits_.header_timeout) continue;
-    // Still the same socket (the descriptor may have been closed and reused since readlink)?
-    if (socket_inode(fd) != inode) continue;
-    cut_off_.fetch_add(1);
-    ::shutdown(fd, SHUT_RDWR);
-    log_event(spdlog::level::warn, "connection.cut_off", {{"peer", peer}, {"header_timeout", limits_.header_timeout}});
-    p.since = now + 3600;  // once is enough; httplib closes it now
+    const bool body = p.in_body, headers_late = !p.in_request && now - p.since > limits_.header_timeout;
+    if (!body && !headers_late) continue;
+    // A descriptor of our own, checked to be the socket readlink named: httplib closes `fd` without
+    // our lock, and the number may meanwhile belong to another client.
+    const int own = fcntl(fd, F_DUPFD_CLOEXEC, 0);
+    if (own < 0) continue;
+    if (socket_inode(own) == inode) {
+      if (body) check_body(own, peer, p, now);
+      if (headers_late) cut_off_headers(own, peer, p, now);
+    }
+    ::close(own);
   }
   closedir(dir);
   // Forget peers whose sockets are gone (a later connection may reuse the port). A request too

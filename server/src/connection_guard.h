@@ -75,6 +75,7 @@ class ConnectionGuard {
   void loop();
   void scan(double now);
   bool check_body(int fd, const std::string& name, Peer& p, double now);
+  void cut_off_headers(int fd, const std::string& name, Peer& p, double now);
 
   const int listen_port_;
   const ConnectionLimits limits_;

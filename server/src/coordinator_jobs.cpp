@@ -71,19 +71,18 @@ Result<SceneUpload> Coordinator::upload_scene(const std::string& bundle) {
 }
 
 Result<SceneUpload> Coordinator::Impl::store_bundle(const std::string& bundle, bool& written) {
-  Impl& s = *this;
-  if (bundle.size() > s.opt.max_upload_bytes)
+  if (bundle.size() > opt.max_upload_bytes)
     return make_error(Code::PayloadTooLarge, "bundle_too_large",
                       "the bundle has " + std::to_string(bundle.size()) + " bytes; the limit is " +
-                          std::to_string(s.opt.max_upload_bytes) + " (tessera-server --max-upload)");
-  BundleResult inspected = inspect_bundle(bundle, s.opt.bundle_limits);
+                          std::to_string(opt.max_upload_bytes) + " (tessera-server --max-upload)");
+  BundleResult inspected = inspect_bundle(bundle, opt.bundle_limits);
   if (!inspected.ok()) return make_error(Code::BadRequest, "bad_bundle", inspected.error);
   const std::string hash = sha256_hex(bundle);
   try {
-    written = !touch_bundle(s.bundle_path(hash));
-    if (written) write_file_durably(s.bundle_path(hash), bundle);
-    s.store.add_scene(hash, bundle.size(), wall_seconds());
-    s.metrics.counters.bytes_in += bundle.size();
+    written = !touch_bundle(bundle_path(hash));
+    if (written) write_file_durably(bundle_path(hash), bundle);
+    store.add_scene(hash, bundle.size(), wall_seconds());
+    metrics.counters.bytes_in += bundle.size();
   } catch (const std::exception& e) {
     if (written) discard_bundle(hash);  // (refused after it was written: not kept)
     return internal_error(e);
@@ -333,8 +332,9 @@ JobStatus Coordinator::Impl::status_of(const JobState& job) {
 
 void Coordinator::Impl::add_lease_counts(JobStatus& status) {
   try {
-    status.leases_issued = store.leases_issued(status.id);
-    status.max_leases_per_unit = store.max_leases_per_unit(status.id);
+    const LeaseCounts counts = store.lease_counts(status.id);
+    status.leases_issued = counts.issued;
+    status.max_leases_per_unit = counts.max_per_unit;
     status.reissued_acknowledged_passes = store.reissued_after_ack(status.id);
   } catch (const std::exception&) {
   }

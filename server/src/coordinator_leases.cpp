@@ -101,8 +101,8 @@ Coordinator::Impl::IssuedLease Coordinator::Impl::issue_lease(uint64_t worker, W
       [this, id = l.id](bool durable) TESSERA_REQUIRES(mu) {
         if (!durable) end_lease(id);  // not logged: never handed out
       });
-  const auto now_steady = Clock::now();
-  add_lease(LeaseInfo{l.id, l.job_id, worker, unit, now_steady + dead_after(), now_steady});
+  const Clock::time_point issued_at = Clock::now();
+  add_lease(LeaseInfo{l.id, l.job_id, worker, unit, issued_at + dead_after(), issued_at});
   set_worker_state(worker, w, WorkerState::Busy);
   if (job.lease_job_part_bytes == 0) job.lease_job_part_bytes = lease_job_part_bytes(l);
   const size_t bytes = lease_json_bytes(l, job.lease_job_part_bytes);
@@ -198,18 +198,20 @@ bool Coordinator::Impl::keep_lease(uint64_t worker, const HeldLease& held) {
   if (!job || is_terminal(job->phase()) || !job->has_unit(held.tile, held.pass)) return false;
   const size_t unit = job->unit(held.tile, held.pass);
   if (job->is_done(unit)) return false;
-  add_lease(LeaseInfo{held.id, held.job, worker, unit, Clock::now() + dead_after(), Clock::now()});
+  const Clock::time_point now = Clock::now();
+  add_lease(LeaseInfo{held.id, held.job, worker, unit, now + dead_after(), now});
   return true;
 }
 
 void Coordinator::Impl::hold_open_leases(JobState& job) {
   // Their workers may still be rendering them: a heartbeat naming the lease re-adopts it, and only
   // a unit nobody claims within dead_after() is leased again (never rendered twice for a restart).
+  const Clock::time_point now = Clock::now();
   for (const LeaseRow& l : store.open_leases(job.id())) {
     if (!job.has_unit(l.tile, l.pass)) continue;
     const size_t unit = job.unit(l.tile, l.pass);
     if (job.is_done(unit)) continue;
-    add_lease(LeaseInfo{l.id, job.id(), l.worker, unit, Clock::now() + dead_after(), Clock::now()});
+    add_lease(LeaseInfo{l.id, job.id(), l.worker, unit, now + dead_after(), now});
   }
 }
 

@@ -130,7 +130,7 @@ class JobState {
   void lease_issued(size_t unit);
   /// The most leases this process issued for any one unit of the job.
   unsigned max_leases_per_unit() const { return max_leases_per_unit_; }
-  /// Whether a speculative copy of the unit may be leased: neither done nor being committed.
+  /// The unit's result is in or being committed: it is never leased again.
   bool unit_finished(size_t unit) const { return is_done(unit) || is_committing(unit); }
   unsigned active_leases(size_t unit) const { return active_leases_[unit]; }
   void lease_ended(size_t unit);

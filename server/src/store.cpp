@@ -361,10 +361,12 @@ uint64_t Store::leases_issued(uint64_t job) {
   return uint64_t(st.i(0));
 }
 
-uint64_t Store::max_leases_per_unit(uint64_t job) {
-  Stmt st(rd_, "SELECT COALESCE(MAX(n), 0) FROM (SELECT COUNT(*) AS n FROM leases WHERE job = ? GROUP BY pass, tile)");
+LeaseCounts Store::lease_counts(uint64_t job) {
+  Stmt st(rd_,
+          "SELECT COALESCE(SUM(n), 0), COALESCE(MAX(n), 0) FROM "
+          "(SELECT COUNT(*) AS n FROM leases WHERE job = ? GROUP BY pass, tile)");
   st.bind(int64_t(job)).step();
-  return uint64_t(st.i(0));
+  return {uint64_t(st.i(0)), uint64_t(st.i(1))};
 }
 
 std::vector<LeaseRow> Store::open_leases(uint64_t job) {

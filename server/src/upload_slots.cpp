@@ -52,11 +52,6 @@ void UploadSlots::release(const std::string& peer) {
   holders_.erase(it);
 }
 
-int UploadSlots::in_use(UploadKind kind) const {
-  std::lock_guard<std::mutex> lock(mu_);
-  return kind == UploadKind::Bundle ? bundles_.in_use : results_.in_use;
-}
-
 int UploadSlots::capacity() const { return bundles_.limits.total + results_.limits.total; }
 
 }  // namespace tessera::server

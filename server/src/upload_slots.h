@@ -33,8 +33,6 @@ class UploadSlots {
   [[nodiscard]] Status acquire(const std::string& peer, const std::string& address, UploadKind kind);
   /// Frees the peer's slot, if it holds one: its request has been answered.
   void release(const std::string& peer);
-  /// Slots of `kind` in use.
-  int in_use(UploadKind kind) const;
   /// Every slot of both kinds: the threads the HTTP pool keeps for uploads.
   int capacity() const;
 

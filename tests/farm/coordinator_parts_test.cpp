@@ -92,7 +92,7 @@ TEST(LeaseTable, HeldCountsAndJobIndexFollowEveryChange) {
     if (rng() % 3 == 0) {
       EXPECT_EQ(leases.end(id).has_value(), model.erase(id) > 0);
     } else {
-      const LeaseInfo l{id, 1 + rng() % 4, 1 + rng() % 5, size_t(rng() % 9), Clock::now()};
+      const LeaseInfo l{id, 1 + rng() % 4, 1 + rng() % 5, size_t(rng() % 9), Clock::now(), Clock::now()};
       leases.add(l);  // (replaces a lease of the same id)
       model[id] = l;
     }

@@ -28,7 +28,14 @@ PassProgram tiles_and_paths() {
   PassProgram p;
   p.spp = 7;
   p.paths_per_unit = 37;
-  p.passes = {PassSpec{UnitKind::Tile, 0, 2}, PassSpec{UnitKind::Paths, 2, 2}, PassSpec{UnitKind::Tile, 4, 3}};
+  auto pass = [](UnitKind kind, uint32_t begin, uint32_t samples) {
+    PassSpec s;
+    s.kind = kind;
+    s.sample_begin = begin;
+    s.samples = samples;
+    return s;
+  };
+  p.passes = {pass(UnitKind::Tile, 0, 2), pass(UnitKind::Paths, 2, 2), pass(UnitKind::Tile, 4, 3)};
   return p;
 }
 
@@ -141,7 +148,9 @@ TEST(PathsJob, AResultOfTheWrongKindOrRangeIsRefused) {
   Lease paths;
   for (int i = 0; i < 100 && !paths.paths; ++i) {  // (pass 0's tiles first, then the ranges)
     paths = lease_of(c.lease(worker, 1));
-    if (!paths.paths) ASSERT_TRUE(c.upload_result(worker, paths.id, render_lease_bytes(paths, scene)).ok());
+    if (!paths.paths) {
+      ASSERT_TRUE(c.upload_result(worker, paths.id, render_lease_bytes(paths, scene)).ok());
+    }
   }
   ASSERT_TRUE(paths.paths);
   EXPECT_EQ(paths.rect, film_window(scene.film)) << "a range's result covers the whole window";

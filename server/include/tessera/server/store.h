@@ -65,6 +65,10 @@ struct CheckpointRow {
   std::string data;
 };
 
+struct LeaseCounts {
+  uint64_t issued = 0, max_per_unit = 0;
+};
+
 struct ResultRow {
   uint32_t tile = 0, pass = 0;
   uint64_t worker = 0;
@@ -127,8 +131,8 @@ class Store {
   /// restart test reads).
   uint64_t reissued_after_ack(uint64_t job);
   uint64_t leases_issued(uint64_t job);
-  /// The most leases logged for any one unit of the job.
-  uint64_t max_leases_per_unit(uint64_t job);
+  /// The job's leases and the most of them for any one unit, in one pass over its lease log.
+  LeaseCounts lease_counts(uint64_t job);
   /// Each unit's newest lease when the unit has no result: the work in flight when the previous
   /// process stopped.
   std::vector<LeaseRow> open_leases(uint64_t job);
