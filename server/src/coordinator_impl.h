@@ -37,6 +37,8 @@
 namespace tessera::server {
 
 struct Coordinator::Impl {
+  class BundleHold;
+
   explicit Impl(CoordinatorOptions o);
 
   CoordinatorOptions opt;
@@ -183,10 +185,19 @@ struct Coordinator::Impl {
   std::unique_ptr<JobState> rebuild_job(const JobRow& row);
   /// Checks and stores an uploaded bundle; `written` says whether this call wrote its file (it was
   /// not stored before), so a submission refused later knows the bundle is its own to delete.
-  Result<SceneUpload> store_bundle(const std::string& bundle, bool& written);
+  /// The bundle is held by `hold` (taken before its file is touched or written).
+  Result<SceneUpload> store_bundle(const std::string& bundle, bool& written, BundleHold& hold);
   /// Deletes a bundle this request wrote for a job that was refused (file, unpacked scene, row),
-  /// unless a job uses it by now (retention.cpp).
+  /// unless a job, or a submission other than the caller's (which holds it once), uses it
+  /// (retention.cpp).
   void discard_bundle(const std::string& hash) TESSERA_EXCLUDES(mu);
+  /// Whether a job, or more than `own_holds` submissions in flight, use the bundle.
+  bool bundle_in_use(const std::string& hash, int own_holds) const TESSERA_REQUIRES(mu);
+  /// Renames the bundle's file and unpacked scene into DATA_DIR/tmp, adding them to `trash`.
+  void move_bundle_aside(const std::string& hash, const char* why, std::vector<std::filesystem::path>& trash)
+      TESSERA_REQUIRES(mu);
+  // Submissions in flight per bundle (BundleHold): a refused one's bundle is kept while another uses it.
+  std::map<std::string, int> bundle_holds TESSERA_GUARDED_BY(mu);
   /// The bundle unpacked into scene_dir (once; serialised per bundle) and the scene XML in it.
   Result<std::string> unpack_scene(const JobSettings& settings, const std::string& bundle_file);
   std::mutex unpack_mutexes_mu;  // (guards only the map of per-bundle mutexes below)
@@ -249,5 +260,21 @@ Status internal_error(const std::exception& e);
 inline Status unknown_job(uint64_t id) {
   return make_error(Code::NotFound, "unknown_job", "no job " + std::to_string(id));
 }
+
+// A submission's claim on a bundle, from before its file is written or touched until the job is
+// added or refused: a concurrent submission of the same bundle that is refused keeps it.
+class Coordinator::Impl::BundleHold {
+ public:
+  explicit BundleHold(Coordinator::Impl& s) : s_(s) {}
+  ~BundleHold();
+  BundleHold(const BundleHold&) = delete;
+  BundleHold& operator=(const BundleHold&) = delete;
+  /// Claims `hash` (once per hold).
+  void take(const std::string& hash);
+
+ private:
+  Coordinator::Impl& s_;
+  std::string hash_;
+};
 
 }  // namespace tessera::server

@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -30,7 +31,11 @@ using nlohmann::json;
 // Written to a temporary name, fsync'd, renamed, directory fsync'd: after a crash the file is
 // either complete or absent.
 void write_file_durably(const std::string& path, const std::string& bytes) {
-  const std::string tmp = path + ".tmp", data_dir = fs::path(path).parent_path().parent_path().string();
+  // A name of its own: two submissions of one new bundle may write it at once (same bytes; the
+  // second rename replaces the first file whole).
+  static std::atomic<uint64_t> writes{0};
+  const std::string tmp = path + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(++writes);
+  const std::string data_dir = fs::path(path).parent_path().parent_path().string();
   int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) throw_write_error("cannot create " + tmp, errno, data_dir);
   size_t off = 0;
@@ -67,10 +72,11 @@ std::string read_file(const std::string& path) {
 
 Result<SceneUpload> Coordinator::upload_scene(const std::string& bundle) {
   bool written = false;
-  return impl_->store_bundle(bundle, written);
+  Impl::BundleHold hold(*impl_);
+  return impl_->store_bundle(bundle, written, hold);
 }
 
-Result<SceneUpload> Coordinator::Impl::store_bundle(const std::string& bundle, bool& written) {
+Result<SceneUpload> Coordinator::Impl::store_bundle(const std::string& bundle, bool& written, BundleHold& hold) {
   if (bundle.size() > opt.max_upload_bytes)
     return make_error(Code::PayloadTooLarge, "bundle_too_large",
                       "the bundle has " + std::to_string(bundle.size()) + " bytes; the limit is " +
@@ -78,6 +84,7 @@ Result<SceneUpload> Coordinator::Impl::store_bundle(const std::string& bundle, b
   BundleResult inspected = inspect_bundle(bundle, opt.bundle_limits);
   if (!inspected.ok()) return make_error(Code::BadRequest, "bad_bundle", inspected.error);
   const std::string hash = sha256_hex(bundle);
+  hold.take(hash);
   try {
     written = !touch_bundle(bundle_path(hash));
     if (written) write_file_durably(bundle_path(hash), bundle);
@@ -133,8 +140,9 @@ Result<JobSubmission> Coordinator::submit_frames(const JobRequest& request, cons
                           " is not a range of 1.." + std::to_string(max_frames) + " frames");
   JobSettings base = request.settings;
   bool written = false;
+  Impl::BundleHold hold(*impl_);
   if (!bundle.empty()) {
-    Result<SceneUpload> uploaded = impl_->store_bundle(bundle, written);
+    Result<SceneUpload> uploaded = impl_->store_bundle(bundle, written, hold);
     if (!uploaded.ok()) return uploaded.status;
     base.scene = uploaded.value.hash;
   }
@@ -214,10 +222,13 @@ Result<JobStatus> Coordinator::submit_one(JobSettings settings, const std::strin
     if (Status st = s.jobs.check_active(s.opt.max_active_jobs); !st.ok()) return st;
   }
   bool written = false;
+  Impl::BundleHold hold(s);
   if (!bundle.empty()) {
-    Result<SceneUpload> uploaded = s.store_bundle(bundle, written);
+    Result<SceneUpload> uploaded = s.store_bundle(bundle, written, hold);
     if (!uploaded.ok()) return uploaded.status;
     settings.scene = uploaded.value.hash;
+  } else if (!settings.scene.empty()) {
+    hold.take(settings.scene);
   }
   // A bundle that came with a job the coordinator refuses is not kept: nothing would ever use it.
   const auto refuse = [&](Status st) {

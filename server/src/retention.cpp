@@ -219,35 +219,59 @@ std::vector<const RetentionJob*> Coordinator::Impl::delete_expired_rows(const st
   return deleted;
 }
 
-bool Coordinator::Impl::move_expired_bundle(const std::string& hash, const RetentionBundle& b, std::vector<fs::path>& trash) {
+bool Coordinator::Impl::bundle_in_use(const std::string& hash, int own_holds) const {
+  if (auto held = bundle_holds.find(hash); held != bundle_holds.end() && held->second > own_holds) return true;
+  for (const auto& [id, job] : jobs.all())
+    if (job->plan().settings.scene == hash) return true;
+  return false;
+}
+
+void Coordinator::Impl::move_bundle_aside(const std::string& hash, const char* why, std::vector<fs::path>& trash) {
   static std::atomic<uint64_t> trash_counter{0};
-  bool referenced = false;  // by a job submitted since the snapshot
-  for (const auto& [id, job] : jobs.all()) referenced |= job->plan().settings.scene == hash;
-  std::error_code ec;
-  const fs::path file = bundle_path(hash);
-  if (referenced || (fs::exists(file, ec) && to_wall(fs::last_write_time(file, ec)) > b.last_use)) return false;
   // Renamed away under the lock: a submission finds the bundle whole or not at all.
+  std::error_code ec;
   const std::string tag = std::to_string(::getpid()) + "-" + std::to_string(++trash_counter);
-  for (const fs::path& p : {file, fs::path(scene_dir(hash))}) {
+  for (const fs::path& p : {fs::path(bundle_path(hash)), fs::path(scene_dir(hash))}) {
     if (!fs::exists(p, ec)) continue;
-    const fs::path to = fs::path(opt.data_dir) / "tmp" / ("expired-" + tag + "-" + p.filename().string());
+    const fs::path to = fs::path(opt.data_dir) / "tmp" / (std::string(why) + "-" + tag + "-" + p.filename().string());
     fs::rename(p, to, ec);
     if (!ec) trash.push_back(to);
   }
+}
+
+bool Coordinator::Impl::move_expired_bundle(const std::string& hash, const RetentionBundle& b, std::vector<fs::path>& trash) {
+  std::error_code ec;
+  const fs::path file = bundle_path(hash);
+  // (Used by a job or a submission since the snapshot, or touched by one since.)
+  if (bundle_in_use(hash, 0) || (fs::exists(file, ec) && to_wall(fs::last_write_time(file, ec)) > b.last_use))
+    return false;
+  move_bundle_aside(hash, "expired", trash);
   log_event(spdlog::level::info, "bundle.expired", {{"scene", hash}, {"bytes", b.bytes}});
   return true;
 }
 
+void Coordinator::Impl::BundleHold::take(const std::string& hash) {
+  MutexLock lock(s_.mu);
+  ++s_.bundle_holds[hash];
+  hash_ = hash;
+}
+
+Coordinator::Impl::BundleHold::~BundleHold() {
+  if (hash_.empty()) return;
+  MutexLock lock(s_.mu);
+  if (auto it = s_.bundle_holds.find(hash_); it != s_.bundle_holds.end() && --it->second == 0) s_.bundle_holds.erase(it);
+}
+
 void Coordinator::Impl::discard_bundle(const std::string& hash) {
+  std::vector<fs::path> trash;
   {
-    // A job that took the same bundle meanwhile keeps it (as retention leaves a referenced one).
+    // A job or another submission using the same bundle keeps it (its caller holds it once).
     MutexLock lock(mu);
-    for (const auto& [id, job] : jobs.all())
-      if (job->plan().settings.scene == hash) return;
+    if (bundle_in_use(hash, 1)) return;
+    move_bundle_aside(hash, "refused", trash);
   }
   std::error_code ec;
-  fs::remove(bundle_path(hash), ec);
-  fs::remove_all(scene_dir(hash), ec);
+  for (const fs::path& p : trash) fs::remove_all(p, ec);
   try {
     store.delete_scene(hash);
   } catch (const std::exception& e) {

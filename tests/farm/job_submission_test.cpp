@@ -4,6 +4,8 @@
 #include "coordinator_fixture.h"
 
 #include <filesystem>
+#include <optional>
+#include <thread>
 
 namespace tessera::test {
 namespace {
@@ -16,7 +18,8 @@ using server::Coordinator;
 size_t stored_bundles(const TempDir& dir) {
   size_t n = 0;
   for (const char* sub : {"bundles", "scenes"})
-    for (const auto& e : fs::directory_iterator(dir.path / "data" / sub)) n += e.path().extension() != ".tmp";
+    for (const auto& e : fs::directory_iterator(dir.path / "data" / sub))
+      n += e.path().extension().string().rfind(".tmp", 0) != 0;  // (not a file being written)
   return n;
 }
 
@@ -66,6 +69,27 @@ TEST(JobSubmission, ABundleOfARefusedJobIsDeleted) {
   EXPECT_FALSE(submit(c, json{{"spp", 1 << 30}}, used).ok());
   auto again = submit(c, json::object(), used);
   EXPECT_TRUE(again.ok()) << again.status.detail;
+}
+
+// Two submissions of one new bundle at once, one refused: the refused one never deletes the bundle
+// while the other is still being stored, unpacked or planned, so the accepted job keeps its bundle.
+TEST(JobSubmission, ARefusedSubmissionKeepsABundleAnotherIsUsing) {
+  TempDir dir;
+  Coordinator c(options(dir));
+  for (int round = 0; round < 30; ++round) {
+    std::string xml = kXml;
+    xml.insert(xml.find("<emitter"), "<!-- round " + std::to_string(round) + " -->\n");
+    const std::string bytes = bundle_in_folder("shared", xml);
+    std::optional<server::Result<JobSubmission>> accepted, refused;
+    std::thread a([&] { accepted.emplace(submit(c, json{{"scene_file", "shared/scene.xml"}}, bytes)); });
+    std::thread b([&] { refused.emplace(submit(c, json{{"scene_file", "shared/scene.xml"}, {"spp", 1 << 30}}, bytes)); });
+    a.join();
+    b.join();
+    ASSERT_TRUE(accepted->ok()) << "round " << round << ": " << accepted->status.detail;
+    EXPECT_FALSE(refused->ok());
+    const std::string hash = accepted->value.jobs.at(0).settings.scene;
+    ASSERT_TRUE(fs::exists(dir.path / "data" / "bundles" / (hash + ".bundle"))) << "round " << round;
+  }
 }
 
 // allow_unsupported, as `tessera render --allow-unsupported`: the coordinator loads the scene with
