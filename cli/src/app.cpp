@@ -27,6 +27,12 @@ void add_connection_options(CLI::App& command, ConnectionOptions& c) {
       ->check(CLI::ExistingFile);
 }
 
+void add_integrator_option(CLI::App& command, std::string& integrator) {
+  // The loader's integrator names (LoadOptions::integrator); it checks them too, for the farm.
+  command.add_option("--integrator", integrator, "Override the integrator: path, volpath, direct, bdpt or ptracer")
+      ->check(CLI::IsMember({"path", "volpath", "direct", "bdpt", "ptracer"}));
+}
+
 int main_entry(int argc, char** argv) {
   // A coordinator refusing an upload closes the connection without reading the rest: the write
   // then fails with EPIPE and the answer (a 413 naming the limit) is printed, not a silent death.

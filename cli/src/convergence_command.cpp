@@ -136,6 +136,7 @@ LoadResult load_for_reference(const ConvergenceOptions& options, const Image& re
   load.allow_unsupported = options.allow_unsupported;
   load.width = options.width;
   load.height = options.height;
+  load.integrator = options.integrator;
   LoadResult loaded = load_scene(parse_scene_file(options.scene), load);
   for (const auto& m : loaded.messages)
     if (m.level == LoadMessage::Level::Warning) std::cerr << "warning: " << m.loc.str() << ": " << m.text << "\n";
@@ -147,8 +148,11 @@ LoadResult load_for_reference(const ConvergenceOptions& options, const Image& re
                              (options.width > 0 || options.height > 0 ? "--width/--height"
                                                                       : "the scene's film; use --width/--height") +
                              ")");
-  if (loaded.scene->integrator.type == IntegratorType::Direct)
-    std::fprintf(stderr, "note: the scene uses the direct integrator, which has no strategies: all equal\n");
+  // The strategies are how path/volpath estimate direct light; the other integrators ignore them.
+  const IntegratorType type = loaded.scene->integrator.type;
+  if (type != IntegratorType::Path && type != IntegratorType::VolPath)
+    std::fprintf(stderr, "note: the scene uses the %s integrator, which has no strategies: all equal\n",
+                 type == IntegratorType::Direct ? "direct" : type == IntegratorType::Bdpt ? "bdpt" : "ptracer");
   return loaded;
 }
 
@@ -209,6 +213,7 @@ Command add_convergence_command(CLI::App& bench) {
   bc->add_option("--height", o->height, "Film height (default: the scene's)")->check(CLI::PositiveNumber);
   bc->add_option("--threads", o->threads, "Render threads (default: all cores)")->check(CLI::NonNegativeNumber);
   bc->add_option("--seed", o->seed, "Seed of the first budget (budget i uses seed + i)");
+  add_integrator_option(*bc, o->integrator);
   bc->add_flag("--allow-unsupported", o->allow_unsupported, "Substitute documented fallbacks for unsupported plugins");
   return {bc, [o] { return run_bench_convergence(*o); }};
 }

@@ -177,7 +177,7 @@ Command add_render_command(CLI::App& app) {
   r->add_option("--tile-size", o->tile_size, "Tile edge in pixels (does not change the image)")->check(CLI::Range(1, 4096));
   r->add_option("--seed", o->seed, "Sampling seed");
   r->add_option("-D", *defines, "Override a scene <default>: -D name=value");
-  r->add_option("--integrator", o->integrator, "Override the integrator")->check(CLI::IsMember({"path", "volpath", "direct"}));
+  add_integrator_option(*r, o->integrator);
   r->add_option("--light-selection", o->light_selection,
                 "How next-event estimation picks a light: power (alias table) or bvh (light hierarchy; default)")
       ->check(CLI::IsMember({"power", "bvh"}));

@@ -4,6 +4,7 @@
 #include "tessera/farm/program_json.h"
 #include "tessera/guiding/tree_io.h"
 #include "tessera/render/aov.h"
+#include "tessera/render/bdpt.h"
 #include "tessera/render/light_sampler.h"
 #include "tessera/sequence/renderer.h"
 #include "tessera/scene/error.h"
@@ -63,7 +64,12 @@ JobPlan make_job_plan(const std::string& bundle_dir, const std::string& scene_fi
       throw SceneError(FileLoc{scene_file, 0}, "the scene references '" + f + "', which is outside its bundle");
     if (std::find(plan.files.begin(), plan.files.end(), rel) == plan.files.end()) plan.files.push_back(rel);
   }
-  plan.program = path_program(path_options(plan));
+  PathProgramOptions options = path_options(plan);
+  options.light_paths = traces_light_paths(s.integrator);
+  if (is_bidirectional(s.integrator.type) && settings.sums_aovs())
+    throw std::invalid_argument("AOVs and denoising need the path tracer (integrator path or volpath): this "
+                                "integrator's light paths are not in a pixel's own samples");
+  plan.program = path_program(options);
   return plan;
 }
 
@@ -105,7 +111,7 @@ TileResult render_lease(const Scene& scene, const Lease& lease, const SpatialTre
                                   : lease.samples;
   if (lease.guide && !guide) throw std::invalid_argument("render_lease: a guided lease without its guide");
   // (The path tracer's passes are Tile passes; a technique that traces light paths renders those.)
-  if (lease.paths) throw std::invalid_argument("render_lease: the path tracer renders no unit of light paths");
+  if (lease.paths) throw std::invalid_argument("render_lease: a lease of light paths (render_paths_lease renders those)");
   // Training goes into a recorder of the guide, whose nonzero sums travel with the result.
   std::optional<SpatialTree> recorder;
   if (lease.guide && lease.guide->train) recorder = make_recorder(*guide);
@@ -117,6 +123,25 @@ TileResult render_lease(const Scene& scene, const Lease& lease, const SpatialTre
   if (recorder) result.training = write_records(*recorder);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return result;
+}
+
+SplatResult render_paths_lease(const Scene& scene, const Lease& lease) {
+  if (!lease.paths) throw std::invalid_argument("render_paths_lease: a lease of a tile");
+  if (!traces_light_paths(scene.integrator))
+    throw std::invalid_argument("render_paths_lease: the scene's integrator traces no light paths");
+  const auto t0 = std::chrono::steady_clock::now();
+  SplatResult r;
+  r.job_id = lease.job_id;
+  r.pass = lease.pass;
+  r.unit = lease.tile;
+  r.path_begin = lease.paths->first;
+  r.path_end = lease.paths->second;
+  thread_local LightSplats splats;
+  splats.reset(film_window(scene.film), scene.film.width, scene.film.height);
+  trace_light_paths(scene, r.path_begin, r.path_end, lease.settings.seed, splats);
+  to_splat_sums(splats, r.splats);
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
 }
 
 namespace {

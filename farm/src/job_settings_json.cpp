@@ -174,8 +174,10 @@ bool check_job_limits(const JobSettings& s, const JobLimits& l, std::string& err
       return fail(std::to_string(tiles) + " tiles of " + std::to_string(s.tile_size) + " pixels exceed the limit of " +
                   std::to_string(l.max_tiles) + " tiles (use a larger tile_size)");
   }
-  if (!s.integrator.empty() && s.integrator != "path" && s.integrator != "volpath" && s.integrator != "direct")
-    return fail("integrator '" + s.integrator + "' is not path, volpath or direct");
+  // The names LoadOptions::integrator takes; checked here so that a typo is refused before a bundle is read.
+  const std::string& i = s.integrator;
+  if (!i.empty() && i != "path" && i != "volpath" && i != "direct" && i != "bdpt" && i != "ptracer")
+    return fail("integrator '" + i + "' is not path, volpath, direct, bdpt or ptracer");
   if (!s.light_selection.empty() && s.light_selection != "power" && s.light_selection != "bvh")
     return fail("light_selection '" + s.light_selection + "' is not power or bvh");
   return true;

@@ -16,7 +16,8 @@ json pass_json(const PassSpec& p) {
           {"film", p.film},
           {"uses", p.uses ? json(*p.uses) : json(nullptr)},
           {"feeds", p.feeds ? json(*p.feeds) : json(nullptr)},
-          {"tile_state", p.tile_state}};
+          {"tile_state", p.tile_state},
+          {"same_samples", p.same_samples}};
 }
 
 std::optional<uint32_t> optional_u32(const json& j) {
@@ -25,7 +26,9 @@ std::optional<uint32_t> optional_u32(const json& j) {
 }
 
 PassSpec pass_from_json(const json& j) {
-  if (j.size() != 10) throw std::invalid_argument("a pass has exactly its ten fields");
+  // (Plans stored before same_samples existed have the other ten.)
+  const bool has_same = j.contains("same_samples");
+  if (j.size() != (has_same ? 11u : 10u)) throw std::invalid_argument("a pass has exactly its eleven fields");
   PassSpec p;
   const std::string kind = j.at("kind").get<std::string>();
   if (kind != "tile" && kind != "paths") throw std::invalid_argument("pass kind '" + kind + "'");
@@ -39,6 +42,7 @@ PassSpec pass_from_json(const json& j) {
   p.uses = optional_u32(j.at("uses"));
   p.feeds = optional_u32(j.at("feeds"));
   p.tile_state = j.at("tile_state").get<bool>();
+  p.same_samples = has_same && j.at("same_samples").get<bool>();
   return p;
 }
 

@@ -38,8 +38,8 @@ bool uncompressed(std::string_view bytes, std::string& raw, std::string_view& vi
 
 }  // namespace
 
-uint64_t max_splat_result_bytes(uint64_t paths, uint64_t max_record_bytes) {
-  const uint64_t raw = kHeaderBytes + 8 + paths * kMaxSplatsPerPath * kSplatBytes + 8 + max_record_bytes + kDigestBytes;
+uint64_t max_splat_result_bytes(uint64_t paths, uint64_t max_record_bytes, uint64_t window_pixels) {
+  const uint64_t raw = kHeaderBytes + 8 + max_splats(paths, window_pixels) * kSplatBytes + 8 + max_record_bytes + kDigestBytes;
   return result_bytes::max_compressed_bytes(raw);
 }
 
@@ -119,7 +119,7 @@ bool decode_splat_result(std::string_view bytes, SplatResult& out, std::string& 
   std::string buffer;
   std::string_view raw;
   // (The range of paths is not known before the header: the size is bounded by the largest range.)
-  if (!uncompressed(bytes, buffer, raw, max_splat_result_bytes(uint64_t(1) << 24, uint64_t(64) << 20), error))
+  if (!uncompressed(bytes, buffer, raw, max_splat_result_bytes(uint64_t(1) << 24, uint64_t(64) << 20, uint64_t(max_pixels)), error))
     return false;
   if (raw.size() < kHeaderBytes + 16 + kDigestBytes || std::memcmp(raw.data(), kMagic, 4) != 0) {
     error = "splat result: bad magic or implausible size";
@@ -133,7 +133,7 @@ bool decode_splat_result(std::string_view bytes, SplatResult& out, std::string& 
   Reader rd{raw};
   if (!read_header(rd, out, error, max_pixels)) return false;
   const uint64_t n = rd.get<uint64_t>(), area = uint64_t(out.splats.window.area());
-  if (n > (out.path_end - out.path_begin) * kMaxSplatsPerPath || body.size() < rd.pos + n * kSplatBytes + 8) {
+  if (n > max_splats(out.path_end - out.path_begin, area) || body.size() < rd.pos + n * kSplatBytes + 8) {
     error = "splat result: " + std::to_string(n) + " splats do not fit its paths or its size";
     return false;
   }

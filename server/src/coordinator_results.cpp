@@ -188,7 +188,7 @@ BodyLimit Coordinator::result_limit(uint64_t worker, uint64_t lease) {
     const JobState* job = l && l->worker == worker ? s.jobs.find(l->job) : nullptr;
     if (job && !job->is_tile_unit(l->unit)) {
       const auto [begin, end] = job->paths(l->unit);
-      return {max_splat_result_bytes(end - begin, kMaxTrainingBytes),
+      return {max_splat_result_bytes(end - begin, kMaxTrainingBytes, uint64_t(job->plan().window.area())),
               "a result of lease " + std::to_string(lease) + " (" + std::to_string(end - begin) + " light paths)"};
     }
     if (job) {

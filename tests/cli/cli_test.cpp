@@ -91,13 +91,13 @@ TEST_F(CliTest, BadInputGivesAnErrorExitCode) {
   EXPECT_EQ(run({"render", scene, "-o", path("x.bmp")}), 2);                    // unknown output format
   EXPECT_EQ(run({"render", scene, "-o", path("x.exr"), "-D", "novalue"}), 2);   // malformed -D
   EXPECT_EQ(run({"render", path("missing.xml"), "-o", path("x.exr")}), 1);      // missing scene
-  EXPECT_NE(run({"render", scene, "-o", path("x.exr"), "--integrator", "bdpt"}), 0);
+  EXPECT_NE(run({"render", scene, "-o", path("x.exr"), "--integrator", "bpdt"}), 0);  // not an integrator
   EXPECT_FALSE(fs::exists(path("x.exr")));
 }
 
 TEST_F(CliTest, EveryIntegratorTheLoaderKnowsIsAccepted) {
   std::string scene = write_scene();
-  for (const char* integrator : {"path", "volpath", "direct"}) {
+  for (const char* integrator : {"path", "volpath", "direct", "bdpt", "ptracer"}) {
     const std::string out = path(std::string(integrator) + ".exr");
     EXPECT_EQ(run({"render", scene, "-o", out, "--integrator", integrator, "-q"}), 0) << integrator;
     EXPECT_TRUE(fs::exists(out)) << integrator;

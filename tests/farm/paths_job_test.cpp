@@ -155,7 +155,8 @@ TEST(PathsJob, AResultOfTheWrongKindOrRangeIsRefused) {
   ASSERT_TRUE(paths.paths);
   EXPECT_EQ(paths.rect, film_window(scene.film)) << "a range's result covers the whole window";
   const server::BodyLimit limit = c.result_limit(worker, paths.id);
-  EXPECT_EQ(limit.bytes, max_splat_result_bytes(paths.paths->second - paths.paths->first, kMaxTrainingBytes));
+  EXPECT_EQ(limit.bytes, max_splat_result_bytes(paths.paths->second - paths.paths->first, kMaxTrainingBytes,
+                                                uint64_t(film_window(scene.film).area())));
   EXPECT_NE(limit.what.find("light paths"), std::string::npos) << limit.what;
 
   Lease as_tile = paths;

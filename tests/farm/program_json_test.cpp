@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 namespace tessera::test {
 namespace {
 
@@ -42,6 +44,12 @@ TEST(ProgramJson, RoundTripsEveryField) {
                   PassSpec{UnitKind::Tile, 2, 2, false, false, false, 1, std::nullopt, std::nullopt, true},
                   PassSpec{UnitKind::Paths, 4, 3, false, false, false, 1}};
   expect_round_trip(paths);
+  PathProgramOptions light;  // a light tracer's: each Tile pass and its light paths
+  light.spp = 8;
+  light.light_paths = true;
+  const PassProgram traced = path_program(light);
+  ASSERT_TRUE(std::any_of(traced.passes.begin(), traced.passes.end(), [](const PassSpec& p) { return p.same_samples; }));
+  expect_round_trip(traced);
 }
 
 TEST(ProgramJson, UnsoundOrMalformedProgramsAreRefused) {
@@ -63,7 +71,7 @@ TEST(ProgramJson, UnsoundOrMalformedProgramsAreRefused) {
   refused(kind, "photons");
   nlohmann::json extra = good;
   extra["passes"][0]["junk"] = 1;
-  refused(extra, "ten fields");
+  refused(extra, "eleven fields");
   nlohmann::json total = good;
   total["spp"] = 9;
   refused(total, "add up to spp");

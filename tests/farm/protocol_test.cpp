@@ -43,6 +43,26 @@ TEST(Protocol, JobSettingsRoundTrip) {
   EXPECT_EQ(back.guiding, std::optional<bool>(false));
 }
 
+// Every integrator the loader has is a job's "integrator"; anything else is refused by the limits
+// check (the API's 422 bad_settings), naming the field.
+TEST(Protocol, IntegratorNamesTheLoaderKnows) {
+  JobLimits limits;
+  for (const char* name : {"", "path", "volpath", "direct", "bdpt", "ptracer"}) {
+    JobSettings s;
+    std::string error;
+    ASSERT_TRUE(job_settings_from_json(json{{"scene", std::string(64, 'a')}, {"integrator", name}}, s, error)) << error;
+    EXPECT_EQ(s.integrator, name);
+    EXPECT_TRUE(check_job_limits(s, limits, error)) << name << ": " << error;
+  }
+  JobSettings s;
+  std::string error;
+  ASSERT_TRUE(job_settings_from_json(json{{"scene", std::string(64, 'a')}, {"integrator", "bpdt"}}, s, error)) << error;
+  EXPECT_FALSE(check_job_limits(s, limits, error));
+  EXPECT_NE(error.find("job settings: integrator 'bpdt' is not path, volpath, direct, bdpt or ptracer"), std::string::npos)
+      << error;
+  EXPECT_NE(parse_error(json{{"scene", std::string(64, 'a')}, {"integrator", 3}}).find("'integrator'"), std::string::npos);
+}
+
 // A number its field cannot hold is out of range (the API's 422, as the limits), named with the
 // range, whether it is negative, a fraction or beyond any JSON integer; a wrong type stays a
 // malformed request (400).
@@ -125,8 +145,9 @@ TEST(Protocol, LimitsNameTheField) {
   s.tile_size = 1;
   EXPECT_FALSE(check_job_limits(s, limits, error));
   s = {};
-  s.integrator = "bdpt";
+  s.integrator = "bpdt";
   EXPECT_FALSE(check_job_limits(s, limits, error));
+  EXPECT_NE(error.find("integrator 'bpdt' is not path, volpath, direct, bdpt or ptracer"), std::string::npos) << error;
   s = {};
   s.width = s.height = 30000;
   EXPECT_FALSE(check_job_limits(s, limits, error));

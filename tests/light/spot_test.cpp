@@ -1,9 +1,9 @@
 // spot light: the intensity profile against Mitsuba 0.6's formula, its projection texture, power()
 // against a numerical integral of the profile, the factory's parameters and defaults.
 //
-// No chi-square test here: sample_li() of a spot is a delta (one direction, pdf 1), and Tessera has
-// no emission-direction sampler for lights (nothing traces light paths), so there is no sampled
-// density to test; the profile the integrators see is checked value by value instead.
+// No chi-square test here: sample_li() of a spot is a delta (one direction, pdf 1), so the profile
+// the integrators see is checked value by value instead. Its emission sampling (sample_le, a
+// uniform cone) is tested with every other emitter's in emission_direction_test.cpp.
 #include "tessera/render/light_bounds.h"
 #include "tessera/light/spot.h"
 #include "tessera/scene/load_context.h"

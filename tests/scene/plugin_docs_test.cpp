@@ -116,7 +116,7 @@ TEST(PluginDocs, DocumentsExactlyTheParametersPluginsRead) {
     body += std::string("<shape type=\"") + shape + "\"/>\n";
   body += "<shape type=\"ply\"><string name=\"filename\" value=\"" + test::source_dir() +
           "/tests/scene/data/triangle.ply\"/></shape>\n";
-  for (const char* integrator : {"path", "volpath", "direct"}) {
+  for (const char* integrator : {"path", "volpath", "direct", "bdpt", "ptracer"}) {
     std::string xml = std::string("<scene version=\"0.6.0\"><integrator type=\"") + integrator + "\"/>" +
                       "<sensor type=\"perspective\"><film type=\"hdrfilm\"/><sampler type=\"independent\"/>"
                       "</sensor>" + body + "</scene>";

@@ -95,7 +95,10 @@ TEST(SceneBuilder, OverridesFromOptions) {
   EXPECT_EQ(r.scene->integrator.type, IntegratorType::Direct);
   EXPECT_TRUE(r.unsupported.empty());  // the replaced integrator's max_depth is not an error
   opt.integrator = "bdpt";
-  EXPECT_NE(scene_error_of([&] { load(body, opt); }).find("bdpt"), std::string::npos);
+  EXPECT_EQ(load(body, opt).scene->integrator.type, IntegratorType::Bdpt);
+  opt.integrator = "bpdt";
+  const std::string e = scene_error_of([&] { load(body, opt); });
+  EXPECT_NE(e.find("unknown integrator 'bpdt' (use path, volpath, direct, bdpt or ptracer)"), std::string::npos) << e;
 }
 
 TEST(SceneBuilder, DefaultIntegratorDependsOnVersion) {

@@ -252,5 +252,38 @@ TEST(PassProgram, FlawsAreNamed) {
   EXPECT_THROW(PassSequencer(everything_program(), toy_frame(8)), std::invalid_argument) << "artifacts need a builder";
 }
 
+// A light tracer's pass of the same samples as the Tile pass before it: its paths are those
+// samples' (path k: sample k / window pixels), and it takes no samples of its own.
+TEST(PassProgram, APassOfTheSameSamplesFollowsItsTilePass) {
+  PassProgram p;
+  p.spp = 5;
+  p.paths_per_unit = 50;
+  auto pass = [](UnitKind kind, uint32_t begin, uint32_t samples, bool same) {
+    PassSpec s;
+    s.kind = kind;
+    s.sample_begin = begin;
+    s.samples = samples;
+    s.same_samples = same;
+    return s;
+  };
+  p.passes = {pass(UnitKind::Tile, 0, 2, false), pass(UnitKind::Paths, 0, 2, true), pass(UnitKind::Tile, 2, 3, false),
+              pass(UnitKind::Paths, 2, 3, true)};
+  ASSERT_EQ(program_error(p), "");
+  const PassSequencer seq(p, toy_frame(8));
+  const uint64_t pixels = uint64_t(seq.frame().window.area());
+  const UnitWork w = seq.work(seq.unit(3, 0));
+  EXPECT_EQ(w.path_begin, 2 * pixels) << "the paths of samples 2, 3 and 4";
+  EXPECT_EQ(seq.units_in(3), uint32_t((3 * pixels + 49) / 50));
+  auto flawed = [&](auto change) {
+    PassProgram q = p;
+    change(q);
+    return program_error(q);
+  };
+  EXPECT_NE(flawed([](PassProgram& q) { q.passes[1].sample_begin = 1; }).find("does not follow"), std::string::npos);
+  EXPECT_NE(flawed([](PassProgram& q) { q.passes[3].samples = 2; }).find("does not follow"), std::string::npos);
+  EXPECT_NE(flawed([](PassProgram& q) { q.passes[2].same_samples = true; }).find("does not follow"), std::string::npos);
+  EXPECT_NE(flawed([](PassProgram& q) { q.passes[1].same_samples = false; }).find("do not follow"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace tessera::test

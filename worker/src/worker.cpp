@@ -178,11 +178,12 @@ std::optional<Lease> Worker::process(const Lease& lease) {
     return dropped;
   };
   std::shared_ptr<const CachedScene> scene, guide;
-  TileResult result;
+  std::string bytes;
   try {
     scene = cache_.get(lease, api_);
     if (lease.guide) guide = cache_.guide(lease, api_);
-    result = render_lease(*scene->scene, lease, guide ? guide->guide.get() : nullptr);
+    bytes = lease.paths ? encode_splat_result(render_paths_lease(*scene->scene, lease))
+                        : encode_tile_result(render_lease(*scene->scene, lease, guide ? guide->guide.get() : nullptr));
   } catch (const std::exception& e) {  // (a scene that does not load, a unit this build cannot render)
     finish();
     ++stats_.failures;
@@ -193,7 +194,7 @@ std::optional<Lease> Worker::process(const Lease& lease) {
   ++stats_.passes_rendered;
   const bool dropped = finish();
   if (dropped) return std::nullopt;
-  std::optional<client::ResultAck> ack = upload(lease, encode_tile_result(result));
+  std::optional<client::ResultAck> ack = upload(lease, bytes);
   if (!ack) return std::nullopt;
   ++stats_.passes_uploaded;
   if (ack->next) ++leases_taken_;

@@ -4,6 +4,7 @@
 // Spheres seen from outside instead sample the cone of directions they subtend (pbrt-v4's
 // Sphere::Sample): every sample lands on the visible cap, where uniform area sampling would waste
 // the half of its samples that fall on the hidden side, and the density is smooth.
+// Emission sampling (sample_le) is uniform by area on every shape, with cosine-weighted directions.
 #include "tessera/light/area.h"
 
 #include "light/emitter_sample.h"
@@ -85,6 +86,25 @@ class AreaLight final : public Light {
     }
     // Shapes sample uniformly by area (see Shape::sample_area).
     return detail::area_pdf_to_solid_angle(ref_p, si, 1.f / shape_.area());
+  }
+
+  // Emission: uniform by area over the whole shape (spheres too: a light path has no reference
+  // point to aim a cone from), then cosine-weighted about the geometric normal.
+  bool sample_le(Vec2 u_pos, Vec2 u_dir, LightEmission& out) const override {
+    const float pdf_pos = detail::inverse_area(shape_.area());
+    if (!(pdf_pos > 0.f) || radiance_.is_black()) return false;
+    Vec3 p, n;
+    float pdf_area = 0.f;
+    shape_.sample_area(u_pos, p, n, pdf_area);
+    if (!(pdf_area > 0.f)) return false;
+    out.p_error = mesh_error_;
+    out.p = sphere_ ? sphere_->reproject(p, out.p_error) : p;
+    return detail::cosine_emission(n, u_dir, pdf_pos, radiance_, out);
+  }
+
+  void pdf_le(Vec3, Vec3 n, Vec3 dir, float& pdf_pos, float& pdf_dir) const override {
+    pdf_pos = detail::inverse_area(shape_.area());
+    pdf_dir = detail::cosine_emission_pdf(n, dir);
   }
 
   float power() const override { return kPi * shape_.area() * radiance_.luminance(); }

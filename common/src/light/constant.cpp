@@ -1,4 +1,7 @@
+// Mitsuba's `constant` emitter (light/constant.h).
 #include "tessera/light/constant.h"
+
+#include "light/emitter_sample.h"
 
 #include "tessera/core/sampling.h"
 #include "tessera/scene/load_context.h"
@@ -25,6 +28,21 @@ bool ConstantLight::sample_li(Vec3 ref_p, Vec2 u, LightSample& out) const {
   out.pdf = kInv4Pi;
   out.delta = false;
   return true;
+}
+
+// Emission: directions uniform over the sphere, as sample_li draws them, from the disk facing each.
+bool ConstantLight::sample_le(Vec2 u_pos, Vec2 u_dir, LightEmission& out) const {
+  if (radiance_.is_black()) return false;
+  if (!detail::EmissionDisk{center_, radius_}.sample(square_to_uniform_sphere(u_dir), u_pos, out)) return false;
+  out.le = radiance_;
+  out.pdf_dir = kInv4Pi;
+  out.delta_dir = false;
+  return true;
+}
+
+void ConstantLight::pdf_le(Vec3, Vec3, Vec3, float& pdf_pos, float& pdf_dir) const {
+  pdf_pos = detail::EmissionDisk{center_, radius_}.pdf_pos();
+  pdf_dir = kInv4Pi;
 }
 
 float ConstantLight::power() const {

@@ -1,5 +1,7 @@
 #include "tessera/light/directional.h"
 
+#include "light/emitter_sample.h"
+
 #include "tessera/scene/load_context.h"
 
 #include <algorithm>
@@ -28,6 +30,22 @@ class DirectionalLight final : public Light {
     out.pdf = 1.f;
     out.delta = true;
     return true;
+  }
+
+  // Emission: the one direction of travel, from a point uniform on the disk that covers the scene's
+  // cross-section; le / pdf_pos = E pi R^2, the power.
+  bool sample_le(Vec2 u_pos, Vec2, LightEmission& out) const override {
+    if (irradiance_.is_black()) return false;
+    if (!detail::EmissionDisk{center_, radius_}.sample(-wi_, u_pos, out)) return false;
+    out.le = irradiance_;
+    out.pdf_dir = 1.f;
+    out.delta_dir = true;
+    return true;
+  }
+
+  void pdf_le(Vec3, Vec3, Vec3, float& pdf_pos, float& pdf_dir) const override {
+    pdf_pos = detail::EmissionDisk{center_, radius_}.pdf_pos();
+    pdf_dir = 1.f;
   }
 
   bool is_delta() const override { return true; }

@@ -1,10 +1,16 @@
 // What the emitters share when sampled from a reference point: the geometry of a delta emitter at a
 // point (point, spot), and of a one-sided emitting surface point (whole-shape and triangle area
-// lights) with the area-to-solid-angle change of measure for its pdf.
+// lights) with the area-to-solid-angle change of measure for its pdf. And what they share when
+// sampled for emission (Light::sample_le): cosine-weighted directions off a diffuse surface, and
+// the disk that distant lights (envmap, sunsky, constant, directional) emit from.
 #pragma once
 
+#include "tessera/core/bounds.h"
+#include "tessera/core/frame.h"
+#include "tessera/core/sampling.h"
 #include "tessera/render/light.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace tessera::detail {
@@ -63,5 +69,62 @@ inline float area_pdf_to_solid_angle(Vec3 ref_p, const SurfaceInteraction& si, f
   const float pdf = pdf_area * dist2 / cos_light;
   return std::isfinite(pdf) ? pdf : 0.f;
 }
+
+/// Uniform density per unit area on a surface of area `area`; 0 when there is no surface (zero
+/// or non-finite area, or an area so small its inverse overflows) to emit from.
+inline float inverse_area(float area) {
+  const float pdf = 1.f / area;
+  return area > 0.f && std::isfinite(pdf) ? pdf : 0.f;
+}
+
+/// Density per unit solid angle of a direction `dir` leaving a diffuse one-sided emitter with
+/// geometric normal `n`: cos / pi on the emitting side, 0 behind it. sample_le and pdf_le both
+/// compute it from the world-space dot product, so the two agree to the bit.
+inline float cosine_emission_pdf(Vec3 n, Vec3 dir) { return std::max(dot(n, dir), 0.f) * kInvPi; }
+
+/// Completes `out` for light leaving the surface point `out.p` (normal `n`, emitting towards +n):
+/// a cosine-weighted direction from `u`. False when the direction grazes the surface (pdf 0).
+inline bool cosine_emission(Vec3 n, Vec2 u, float pdf_pos, Rgb radiance, LightEmission& out) {
+  out.dir = normalize(Frame(n).to_world(square_to_cosine_hemisphere(u)));
+  out.n = n;
+  out.le = radiance;
+  out.pdf_pos = pdf_pos;
+  out.pdf_dir = cosine_emission_pdf(n, out.dir);
+  out.delta_pos = out.delta_dir = out.infinite = false;
+  return out.pdf_dir > 0.f && std::isfinite(pdf_pos) && pdf_pos > 0.f;
+}
+
+/// Where a distant light's rays start: the disk of the scene's bounding-sphere radius facing the
+/// direction of travel, one radius behind the sphere, so that every ray through the disk along
+/// `dir` covers the whole scene and pdf_pos = 1 / (pi R^2) is uniform over its cross-section.
+struct EmissionDisk {
+  Vec3 center;
+  float radius = 0.f;
+
+  static EmissionDisk around(const Bounds3& scene_bounds) {
+    if (scene_bounds.empty()) return {};
+    return {scene_bounds.center(), 0.5f * length(scene_bounds.diagonal())};
+  }
+  /// 0 for a scene without extent (nothing to light; sample_le then fails).
+  float pdf_pos() const {
+    const float pdf = 1.f / (kPi * radius * radius);
+    return radius > 0.f && std::isfinite(pdf) ? pdf : 0.f;
+  }
+  /// Sets out.p, n, p_error, pdf_pos and the flags of a ray along the unit `dir`; the caller sets
+  /// le, pdf_dir and delta_dir. False when the disk is degenerate.
+  bool sample(Vec3 dir, Vec2 u, LightEmission& out) const {
+    out.pdf_pos = pdf_pos();
+    if (!(out.pdf_pos > 0.f)) return false;
+    const Frame frame(dir);
+    const Vec2 d = square_to_uniform_disk_concentric(u);
+    out.p = center + (frame.s * d.x + frame.t * d.y - dir) * radius;
+    out.n = dir;
+    out.p_error = Vec3(0.f);
+    out.dir = dir;
+    out.delta_pos = false;
+    out.infinite = true;
+    return true;
+  }
+};
 
 }  // namespace tessera::detail

@@ -1,6 +1,8 @@
 // Environment map light; conventions and the sampling scheme are documented in light/envmap.h.
 #include "tessera/light/envmap.h"
 
+#include "light/emitter_sample.h"
+
 #include "tessera/core/check.h"
 #include "tessera/scene/load_context.h"
 
@@ -122,7 +124,7 @@ float EnvmapLight::pdf_light(Vec3 d) const {
 
 float EnvmapLight::pdf_env(Vec3 d) const { return pdf_light(to_light(d)); }
 
-bool EnvmapLight::sample_li(Vec3 ref_p, Vec2 u, LightSample& out) const {
+bool EnvmapLight::sample_direction(Vec2 u, Vec3& d_light, Vec2& uv, float& pdf) const {
   float pdf_cell = 0.f;
   Vec2 s = distribution_.sample(u, &pdf_cell);
   if (!(pdf_cell > 0.f)) return false;
@@ -133,12 +135,19 @@ bool EnvmapLight::sample_li(Vec3 ref_p, Vec2 u, LightSample& out) const {
   double sin_theta = std::sqrt(std::max(0.0, (1.0 - cos_theta) * (1.0 + cos_theta)));
   double u_tex = double(s.x) + 0.5 / width_;
   double phi = 2.0 * kPiD * u_tex;
-  Vec3 d_light(float(std::sin(phi) * sin_theta), float(cos_theta), float(-std::cos(phi) * sin_theta));
-  float v_tex = float(std::atan2(sin_theta, cos_theta) / kPiD);
+  d_light = Vec3(float(std::sin(phi) * sin_theta), float(cos_theta), float(-std::cos(phi) * sin_theta));
+  uv = Vec2(float(u_tex >= 1.0 ? u_tex - 1.0 : u_tex), float(std::atan2(sin_theta, cos_theta) / kPiD));
+  pdf = pdf_cell * inv_cell_solid_angle_[size_t(j)];
+  return true;
+}
 
+bool EnvmapLight::sample_li(Vec3 ref_p, Vec2 u, LightSample& out) const {
+  Vec3 d_light;
+  Vec2 uv;
+  float pdf = 0.f;
+  if (!sample_direction(u, d_light, uv, pdf)) return false;
   Vec3 wi = to_world(d_light);
   float r = std::max({radius_, length(ref_p - center_), 1e-3f});
-  const Vec2 uv(float(u_tex >= 1.0 ? u_tex - 1.0 : u_tex), v_tex);
   if (out.defer_li) {
     out.li_uv = uv;
     out.li_deferred = true;
@@ -149,9 +158,31 @@ bool EnvmapLight::sample_li(Vec3 ref_p, Vec2 u, LightSample& out) const {
   out.p_light = ref_p + wi * (2.f * r);
   out.n_light = Vec3(0.f);
   out.dist = kInfinity;
-  out.pdf = pdf_cell * inv_cell_solid_angle_[size_t(j)];
+  out.pdf = pdf;
   out.delta = false;
   return out.pdf > 0.f;
+}
+
+// Emission: the direction sample_li would pick towards the map, travelling the other way, from
+// the disk facing it. Density and radiance are those of pdf_env() and le_env() at the final world
+// direction (not of the cell drawn), so that pdf_le() and a camera ray that escapes along it
+// agree with this sample to the bit.
+bool EnvmapLight::sample_le(Vec2 u_pos, Vec2 u_dir, LightEmission& out) const {
+  Vec3 d_light;
+  Vec2 uv;
+  float pdf = 0.f;
+  if (!sample_direction(u_dir, d_light, uv, pdf)) return false;
+  const Vec3 wi = to_world(d_light);
+  if (!detail::EmissionDisk{center_, radius_}.sample(-wi, u_pos, out)) return false;
+  out.pdf_dir = pdf_env(wi);
+  out.le = le_env(wi);
+  out.delta_dir = false;
+  return out.pdf_dir > 0.f && !out.le.is_black();
+}
+
+void EnvmapLight::pdf_le(Vec3, Vec3, Vec3 dir, float& pdf_pos, float& pdf_dir) const {
+  pdf_pos = detail::EmissionDisk{center_, radius_}.pdf_pos();
+  pdf_dir = pdf_env(-dir);
 }
 
 void EnvmapLight::preprocess(const Bounds3& scene_bounds) {

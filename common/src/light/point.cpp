@@ -1,7 +1,9 @@
+// Isotropic point light: a delta in position, emitting the same intensity in every direction.
 #include "tessera/light/point.h"
 
 #include "light/emitter_sample.h"
 
+#include "tessera/core/sampling.h"
 #include "tessera/render/light_bounds.h"
 #include "tessera/scene/load_context.h"
 
@@ -16,6 +18,26 @@ class PointLight final : public Light {
     if (!detail::point_emitter_sample(position_, ref_p, out)) return false;
     out.li *= intensity_;
     return true;
+  }
+
+  // Emission: uniform over the sphere of directions, so le / pdf_dir = 4 pi I, the power.
+  bool sample_le(Vec2, Vec2 u_dir, LightEmission& out) const override {
+    if (intensity_.is_black()) return false;
+    out.p = position_;
+    out.n = Vec3(0.f);
+    out.p_error = Vec3(0.f);
+    out.dir = square_to_uniform_sphere(u_dir);
+    out.le = intensity_;
+    out.pdf_pos = 1.f;
+    out.pdf_dir = kInv4Pi;
+    out.delta_pos = true;
+    out.delta_dir = out.infinite = false;
+    return true;
+  }
+
+  void pdf_le(Vec3, Vec3, Vec3, float& pdf_pos, float& pdf_dir) const override {
+    pdf_pos = 1.f;
+    pdf_dir = kInv4Pi;
   }
 
   bool is_delta() const override { return true; }

@@ -11,6 +11,8 @@
 #include "light/emitter_sample.h"
 
 #include "tessera/core/check.h"
+#include "tessera/core/frame.h"
+#include "tessera/core/sampling.h"
 #include "tessera/render/light_bounds.h"
 #include "tessera/scene/load_context.h"
 
@@ -42,6 +44,11 @@ class SpotLight final : public Light {
     power_ = float(solid_angle * scale);
     bounds_phi_ = float(4.0 * kPiD * scale);
     cos_beam_spread_ = float(std::cos(cutoff - beam));
+    // The cone sample_le draws from ends at the float cos_cutoff_; its solid angle in double, since
+    // for narrow spots 1 - cos loses its digits in float. 0 (no emission sampling) for a cutoff
+    // too narrow for float to tell from the axis.
+    const double inv_cone = 1.0 / (2.0 * kPiD * (1.0 - double(cos_cutoff_)));
+    inv_cone_solid_angle_ = std::isfinite(float(inv_cone)) ? float(inv_cone) : 0.f;
   }
 
   bool sample_li(Vec3 ref_p, Vec2, LightSample& out) const override {
@@ -53,6 +60,28 @@ class SpotLight final : public Light {
     if (profile.is_black()) return false;
     out.li *= profile;
     return true;
+  }
+
+  // Emission: directions uniform in the cone of the cutoff (the spot's total width) around its
+  // axis, weighted by the profile; le / pdf_dir then averages to the power over that cone.
+  bool sample_le(Vec2, Vec2 u_dir, LightEmission& out) const override {
+    if (!(power_ > 0.f)) return false;
+    out.dir = normalize(Frame(axis_).to_world(square_to_uniform_cone(u_dir, cos_cutoff_)));
+    out.le = eval_profile(normalize(light_from_world_.apply_vector(out.dir)));
+    if (out.le.is_black()) return false;
+    out.p = position_;
+    out.n = Vec3(0.f);
+    out.p_error = Vec3(0.f);
+    out.pdf_pos = 1.f;
+    out.pdf_dir = cone_pdf(out.dir);
+    out.delta_pos = true;
+    out.delta_dir = out.infinite = false;
+    return out.pdf_dir > 0.f;
+  }
+
+  void pdf_le(Vec3, Vec3, Vec3 dir, float& pdf_pos, float& pdf_dir) const override {
+    pdf_pos = 1.f;
+    pdf_dir = cone_pdf(dir);
   }
 
   bool is_delta() const override { return true; }
@@ -89,12 +118,19 @@ class SpotLight final : public Light {
     return result * ((cutoff_ - std::acos(cos_theta)) * inv_transition_);
   }
 
+  /// Solid-angle density of sample_le's uniform cone. The cone is built around the world axis, so
+  /// to_world must be rigid (up to uniform scale), as a look_at is, for it to match the profile.
+  float cone_pdf(Vec3 dir) const {
+    if (!(dot(dir, axis_) >= cos_cutoff_)) return 0.f;
+    return inv_cone_solid_angle_;
+  }
+
   Transform light_from_world_;
   Vec3 position_, axis_;
   Rgb intensity_;
   std::shared_ptr<const Texture> texture_;
   float cutoff_, cos_cutoff_, cos_beam_, inv_transition_, uv_factor_;
-  float power_, bounds_phi_, cos_beam_spread_;
+  float power_, bounds_phi_, cos_beam_spread_, inv_cone_solid_angle_;
 };
 
 }  // namespace

@@ -53,6 +53,22 @@ class TriangleLight final : public Light {
     return detail::area_pdf_to_solid_angle(ref_p, si, 1.f / area_);
   }
 
+  // Emission: uniform by area, then cosine-weighted about the (one-sided) normal.
+  bool sample_le(Vec2 u_pos, Vec2 u_dir, LightEmission& out) const override {
+    const float pdf_pos = detail::inverse_area(area_);
+    if (!(pdf_pos > 0.f) || radiance_.is_black()) return false;
+    const Vec2 b = square_to_uniform_triangle(u_pos);
+    const float b0 = 1.f - b.x - b.y;
+    out.p = p0_ * b0 + p1_ * b.x + p2_ * b.y;
+    out.p_error = barycentric_point_error(p0_, p1_, p2_, b0, b.x, b.y);
+    return detail::cosine_emission(n_, u_dir, pdf_pos, radiance_, out);
+  }
+
+  void pdf_le(Vec3, Vec3 n, Vec3 dir, float& pdf_pos, float& pdf_dir) const override {
+    pdf_pos = detail::inverse_area(area_);
+    pdf_dir = detail::cosine_emission_pdf(n, dir);
+  }
+
   float power() const override { return kPi * area_ * radiance_.luminance(); }
 
   bool light_bounds(LightBounds& out) const override {

@@ -86,9 +86,21 @@ void Film::add_tile(const FilmTile& tile) {
 
 Rgb Film::mean(Vec2i p) const {
   const PixelSums& s = pixel(p);
-  if (s.count == 0) return {};
-  double inv = 1.0 / double(s.count);
-  return {float(s.sum[0] * inv), float(s.sum[1] * inv), float(s.sum[2] * inv)};
+  Rgb m;
+  if (s.count > 0) {
+    const double inv = 1.0 / double(s.count);
+    m = {float(s.sum[0] * inv), float(s.sum[1] * inv), float(s.sum[2] * inv)};
+  }
+  if (splats_.empty() || !(splat_paths_per_pixel_ > 0)) return m;
+  const size_t i = index(p) * 3;
+  for (int c = 0; c < 3; ++c) m[c] = float(double(m[c]) + splats_[i + size_t(c)] / splat_paths_per_pixel_);
+  return m;
+}
+
+void Film::set_splats(std::vector<double> sums, double paths_per_pixel) {
+  TESSERA_CHECK(sums.empty() || sums.size() == pixels_.size() * 3);
+  splats_ = std::move(sums);
+  splat_paths_per_pixel_ = paths_per_pixel;
 }
 
 Rgb Film::sample_variance(Vec2i p) const {

@@ -1,5 +1,7 @@
 // Pixel filters, applied by filter importance sampling: each filter draws film offsets distributed
 // like its (separable) kernel, so a pixel is the plain mean of its samples' radiance.
+// camera.h uses Rgb without including rgb.h (reported to the lead); included first until fixed.
+#include "tessera/core/rgb.h"
 #include "tessera/render/camera.h"
 
 #include "tessera/core/check.h"
@@ -19,6 +21,10 @@ class BoxFilter final : public Filter {
   }
   float radius() const override { return radius_; }
   std::string name() const override { return "box"; }
+  float eval(Vec2 o) const override {
+    if (std::abs(o.x) > radius_ || std::abs(o.y) > radius_) return 0.f;
+    return 1.f / (4.f * radius_ * radius_);
+  }
 
  private:
   float radius_;
@@ -30,8 +36,11 @@ class TentFilter final : public Filter {
   Vec2 sample(Vec2 u) const override { return {sample_1d(u.x), sample_1d(u.y)}; }
   float radius() const override { return radius_; }
   std::string name() const override { return "tent"; }
+  float eval(Vec2 o) const override { return eval_1d(o.x) * eval_1d(o.y); }
 
  private:
+  // The normalised triangle (1 - |x|/r) / r, the density sample_1d draws.
+  float eval_1d(float x) const { return std::max(0.f, 1.f - std::abs(x) / radius_) / radius_; }
   // Inverse of the tent CDF on [-r, r]: each half holds half of the mass.
   float sample_1d(float u) const {
     if (u < 0.5f) return radius_ * (std::sqrt(2.f * u) - 1.f);
@@ -59,13 +68,23 @@ class GaussianFilter final : public Filter {
     double total = cdf_.back();
     for (double& c : cdf_) c /= total;
     cdf_.back() = 1.0;
+    bias_ = bias;
+    inv_norm_ = 1.0 / total;
   }
   Vec2 sample(Vec2 u) const override { return {sample_1d(u.x), sample_1d(u.y)}; }
   float radius() const override { return radius_; }
   std::string name() const override { return "gaussian"; }
+  // The exact kernel, not the tabulated one sample() inverts: the two differ far below sampling noise.
+  float eval(Vec2 o) const override { return float(eval_1d(o.x) * eval_1d(o.y)); }
 
  private:
   static constexpr int kBins = 4096;
+
+  double eval_1d(float x) const {
+    if (std::abs(x) > radius_) return 0.0;
+    const double s = stddev_, v = std::exp(-double(x) * x / (2 * s * s)) - bias_;
+    return std::max(0.0, v) * inv_norm_;
+  }
 
   float sample_1d(float u) const {
     double x = u;
@@ -78,6 +97,7 @@ class GaussianFilter final : public Filter {
   }
 
   float stddev_, radius_;
+  double bias_ = 0, inv_norm_ = 0;  // kernel offset and 1 / its integral over [-r, r]
   std::vector<double> cdf_;
 };
 

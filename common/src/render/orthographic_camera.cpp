@@ -9,6 +9,8 @@
 // tmin = near_clip and tmax = far_clip measured along it (Mitsuba 0.6; Mitsuba 3 starts the ray at
 // z = near_clip in camera space, the same unless to_world scales z).
 #include "tessera/core/check.h"
+// camera.h uses Rgb without including rgb.h (reported to the lead); included first until fixed.
+#include "tessera/core/rgb.h"
 #include "tessera/render/camera.h"
 
 namespace tessera {

@@ -10,6 +10,7 @@
 #include "tessera/core/frame.h"
 #include "tessera/core/sampling.h"
 #include "tessera/render/guided_sampling.h"
+#include "tessera/render/bdpt.h"
 #include "tessera/render/integrator.h"
 
 #include <algorithm>
@@ -346,6 +347,8 @@ std::unique_ptr<Integrator> make_path_integrator(const IntegratorSettings& setti
 std::unique_ptr<Integrator> make_integrator(const IntegratorSettings& settings) {
   switch (settings.type) {
     case IntegratorType::Direct: return make_direct_integrator(settings);
+    case IntegratorType::Bdpt: return make_bdpt_integrator(settings);
+    case IntegratorType::Ptracer: return make_ptracer_integrator(settings);
     case IntegratorType::Path:
     case IntegratorType::VolPath: break;
   }

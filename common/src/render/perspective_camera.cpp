@@ -13,6 +13,15 @@
 // plane; the ray goes from a through that focus point (Mitsuba 0.6 and 3 sample_ray). A point at
 // depth d off the focus plane f is thus spread over a disk of radius aperture_radius |d - f| / d on
 // the focus plane, i.e. aperture_radius |d - f| / (d f) in units of the z = 1 image plane.
+//
+// Importance (pbrt-v4's PerspectiveCamera::We/PDF_We/SampleWi) is computed in camera space, where
+// the film, lens and clip planes have their simple shapes. A uniform scale s in world_from_camera
+// leaves angles alone, so cos theta and the film area A (on the plane at distance 1) are the same
+// in both spaces; only lens areas are world areas, pi (s r)^2, because the light-transport
+// measures (pdf_pos, the area-to-solid-angle conversion in sample_wi) are taken in world space.
+
+// camera.h uses Rgb without including rgb.h (reported to the lead); included first until fixed.
+#include "tessera/core/rgb.h"
 #include "tessera/render/camera.h"
 
 #include "tessera/core/check.h"
@@ -38,6 +47,60 @@ class PerspectiveCamera final : public Camera {
     tan_half_x_ = float(std::tan(double(fov_x_degrees) * kPi / 360.0));
     tan_half_y_ = float(double(tan_half_x_) / aspect);
     origin_ = world_from_camera_.apply_point(Vec3(0.f));
+    camera_from_world_ = world_from_camera_.inverse();
+    const Vec3 axis = world_from_camera_.apply_vector(Vec3(0.f, 0.f, 1.f));
+    const float scale = length(axis);
+    forward_ = axis / scale;
+    width_ = float(width);
+    height_ = float(height);
+    film_area_ = 4.f * tan_half_x_ * tan_half_y_;
+    // pbrt's convention: a pinhole's "lens area" is 1, so pdf_pos = 1 for its delta position.
+    lens_area_ = aperture_ > 0.f ? kPi * (scale * aperture_) * (scale * aperture_) : 1.f;
+  }
+
+  bool has_importance() const override { return true; }
+
+  Rgb we(const Ray& ray, Vec2* raster) const override {
+    Vec2 r;
+    float cos_theta;
+    if (!film_hit(ray, r, cos_theta)) return {};
+    if (raster) *raster = r;
+    return Rgb(importance(cos_theta));
+  }
+
+  void pdf_we(const Ray& ray, float& pdf_pos, float& pdf_dir) const override {
+    Vec2 r;
+    float cos_theta;
+    if (!film_hit(ray, r, cos_theta)) {
+      pdf_pos = pdf_dir = 0.f;
+      return;
+    }
+    pdf_pos = 1.f / lens_area_;
+    pdf_dir = 1.f / (film_area_ * cos_theta * cos_theta * cos_theta);
+  }
+
+  bool sample_wi(Vec3 ref_p, Vec2 u_lens, float /*time*/, CameraSampleWi& out) const override {
+    const Vec3 p = camera_from_world_.apply_point(ref_p);
+    // generate_ray's rays span camera z in [near, far]: nearer or farther points are not seen.
+    if (!(p.z > 0.f && p.z >= near_ && p.z <= far_)) return false;
+    const Vec2 lens = aperture_ > 0.f ? square_to_uniform_disk_concentric(u_lens) * aperture_ : Vec2(0.f, 0.f);
+    const Vec3 a(lens.x, lens.y, 0.f);
+    // generate_ray aims from the lens point at the pinhole ray's point on the focus plane, so the
+    // raster is the one whose pinhole ray meets the line a -> p on that plane.
+    const float f = focus_plane(), k = f / p.z;
+    const Vec2 raster = raster_from_image((a.x + (p.x - a.x) * k) / f, (a.y + (p.y - a.y) * k) / f);
+    if (!on_film(raster)) return false;
+    out.p_lens = world_from_camera_.apply_point(a);
+    const Vec3 to_lens = out.p_lens - ref_p;
+    out.dist = length(to_lens);
+    if (!(out.dist > 0.f)) return false;
+    out.wi = to_lens / out.dist;
+    out.n = forward_;
+    const float cos_theta = normalize(p - a).z;
+    out.we = Rgb(importance(cos_theta));
+    out.pdf = out.dist * out.dist / (cos_theta * lens_area_);
+    out.raster = raster;
+    return true;
   }
 
   Ray generate_ray(Vec2 raster, Vec2 u_lens) const override {
@@ -66,9 +129,39 @@ class PerspectiveCamera final : public Camera {
   }
 
  private:
-  Transform world_from_camera_;
-  Vec3 origin_;
+  // Rays through the lens converge on the focus plane; a pinhole's rays can use any plane.
+  float focus_plane() const { return aperture_ > 0.f ? focus_ : 1.f; }
+
+  // Inverse of generate_ray's map from raster to the point (px, py, 1) on the image plane.
+  Vec2 raster_from_image(float px, float py) const {
+    return {0.5f * (1.f - px / tan_half_x_) * width_, 0.5f * (1.f - py / tan_half_y_) * height_};
+  }
+
+  // Half-open like the pixels, so a splat never lands in a column or row past the film.
+  bool on_film(Vec2 r) const { return r.x >= 0.f && r.x < width_ && r.y >= 0.f && r.y < height_; }
+
+  float importance(float cos_theta) const {
+    const float cos2 = cos_theta * cos_theta;
+    return 1.f / (film_area_ * lens_area_ * cos2 * cos2);
+  }
+
+  // Where `ray` (leaving the lens) crosses the film, and the cosine of its angle to the axis:
+  // false when it points backwards or misses the film.
+  bool film_hit(const Ray& ray, Vec2& raster, float& cos_theta) const {
+    const Vec3 o = camera_from_world_.apply_point(ray.o);
+    const Vec3 d = normalize(camera_from_world_.apply_vector(ray.d));
+    if (!(d.z > 0.f)) return false;
+    cos_theta = d.z;
+    const float f = focus_plane();
+    const Vec3 q = o + d * ((f - o.z) / d.z);
+    raster = raster_from_image(q.x / f, q.y / f);
+    return on_film(raster);
+  }
+
+  Transform world_from_camera_, camera_from_world_;
+  Vec3 origin_, forward_;
   float near_, far_, aperture_, focus_;
+  float width_, height_, film_area_, lens_area_;
   float inv_width_, inv_height_;
   float tan_half_x_, tan_half_y_;
 };

@@ -22,9 +22,14 @@ struct BuildState {
   int spp_budget = 0;
 };
 
+/// The <integrator> into scene.integrator (integrator_builder.cpp).
 void build_integrator(BuildState& st);
 /// A `guided_path` integrator's guiding parameters (guided_path_builder.cpp).
 void read_guided_path(BuildState& st, const SceneNode& node);
+/// "path", "volpath", "direct", "bdpt", "ptracer": the name scenes and --integrator use.
+const char* integrator_name(IntegratorType type);
+/// After finish_media: bdpt and ptracer refuse a sensor they cannot importance-sample.
+void check_integrator_sensor(BuildState& st);
 void build_sensor(BuildState& st);  // after the shapes: a missing sensor is fitted to the scene bounds
 void build_shapes(BuildState& st);
 // The sensor's shutterOpen/shutterClose into scene.shutter_*: before the shapes, which move over it.
@@ -40,8 +45,17 @@ struct ShapeMedia {
 };
 ShapeMedia build_shape_media(BuildState& st, const SceneNode& shape);
 /// After shapes and sensor: the camera's medium, and the integrator against the media present
-/// (volpath without media is path; path with media ignores them, with one warning).
+/// (volpath without media is path; path with media ignores them, with one warning; bdpt and ptracer
+/// with media are volpath, with a note).
 void finish_media(BuildState& st);
+
+/// An integer parameter in [lo, hi]; outside it, a SceneError at the parameter's file and line.
+int64_t get_int_in(const SceneNode& node, const std::string& name, int64_t def, int64_t lo, int64_t hi);
+/// Every node after the first of a kind the scene may have once (sensor, integrator): reported.
+void report_extras(BuildState& st, const std::vector<std::shared_ptr<SceneNode>>& nodes, const char* what);
+/// The name a parameter of a Mitsuba 0.6 plugin goes by in `node`: 0.x files reach us as snake_case
+/// (maxDepth as max_depth), a 2.x/3.x file keeps the name as written, so either may be there.
+std::string name_in(const SceneNode& node, const std::string& snake, const std::string& camel);
 
 /// What --allow-unsupported substitutes for an unsupported plugin node.
 std::string fallback_for(const SceneNode& node);

@@ -7,13 +7,14 @@
 #include <string>
 
 namespace tessera::detail {
-namespace {
 
-// Scenes for the plugin are Mitsuba 0.x files, whose camelCase names reach us as snake_case
+// Scenes for the 0.6 plugins are Mitsuba 0.x files, whose camelCase names reach us as snake_case
 // (sTreeThreshold as s_tree_threshold); a 2.x/3.x file keeps the name as written.
 std::string name_in(const SceneNode& node, const std::string& snake, const std::string& camel) {
   return node.peek(snake) || !node.peek(camel) ? snake : camel;
 }
+
+namespace {
 
 /// A string parameter that must be one of `allowed`.
 std::string choice(const SceneNode& node, const std::string& name, const std::string& def,

@@ -48,10 +48,17 @@ void finish_media(BuildState& st) {
   IntegratorSettings& integrator = scene.integrator;
   auto nodes = st.desc.root->children_with_tag("integrator");
   FileLoc loc = nodes.empty() ? st.desc.root->loc : nodes[0]->loc;
+  const bool bidirectional = integrator.type == IntegratorType::Bdpt || integrator.type == IntegratorType::Ptracer;
   if (integrator.type == IntegratorType::VolPath && !media) {
     integrator.type = IntegratorType::Path;  // the same estimator; no medium dimensions to draw
+  } else if (bidirectional && media) {
+    // Bdpt and Ptracer trace surfaces only; volpath converges to the image they were asked for.
+    st.ctx.note(loc, std::string("the '") + integrator_name(integrator.type) +
+                         "' integrator does not render participating media (volumetric BDPT is not built): "
+                         "this scene, which has media, is rendered by 'volpath' (the same expected image)");
+    integrator.type = IntegratorType::VolPath;
   } else if (integrator.type != IntegratorType::VolPath && media) {
-    st.ctx.warn(loc, std::string("the '") + (integrator.type == IntegratorType::Direct ? "direct" : "path") +
+    st.ctx.warn(loc, std::string("the '") + integrator_name(integrator.type) +
                          "' integrator ignores the participating media of this scene (use volpath to render them)");
   }
 }

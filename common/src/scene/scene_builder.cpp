@@ -295,6 +295,7 @@ LoadResult load_scene(const SceneDesc& desc, const LoadOptions& options) {
     scene->sampler.sample_count = st.spp_budget;
   }
   detail::finish_media(st);
+  detail::check_integrator_sensor(st);
   detail::report_unsupported(st);
   if (!options.allow_unsupported && !ctx.unsupported_items().empty())
     throw UnsupportedError(ctx.unsupported_items());

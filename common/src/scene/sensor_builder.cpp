@@ -1,4 +1,4 @@
-// Integrator settings, and the sensor with its film, reconstruction filter and sampler, following
+// The sensor with its film, reconstruction filter and sampler, following
 // Mitsuba 0.6/3 parameter names and defaults.
 #include "tessera/scene/load_context.h"
 
@@ -15,20 +15,27 @@ bool sensor_has_fov(const std::string& type);
 std::unique_ptr<Camera> make_sensor_camera(LoadContext& ctx, const SceneNode& sensor, const Transform& to_world,
                                            float fov_x, const FilmSettings& film, float near_clip, float far_clip);
 
+int64_t get_int_in(const SceneNode& node, const std::string& name, int64_t def, int64_t lo, int64_t hi) {
+  int64_t v = node.get_int(name, def);
+  if (v < lo || v > hi)
+    throw SceneError(node.loc_of(name), "'" + name + "' of " + node.describe() + " must be in [" + std::to_string(lo) +
+                                            ", " + std::to_string(hi) + "], got " + std::to_string(v));
+  return v;
+}
+
+void report_extras(BuildState& st, const std::vector<std::shared_ptr<SceneNode>>& nodes, const char* what) {
+  for (size_t i = 1; i < nodes.size(); ++i) {
+    st.ctx.unsupported(nodes[i]->loc, "additional " + nodes[i]->describe(), std::string("ignored (the first ") + what +
+                                                                                " is used)");
+    st.reported.insert(nodes[i].get());
+  }
+}
+
 namespace {
 
 constexpr double kPiD = 3.14159265358979323846;
 constexpr int64_t kMaxFilmSize = 1 << 15;   // pixels per side; keeps width*height well inside int
 constexpr int64_t kMaxSamples = 1 << 24;    // per pixel
-
-int64_t get_int_in(const SceneNode& node, const char* name, int64_t def, int64_t lo, int64_t hi) {
-  int64_t v = node.get_int(name, def);
-  if (v < lo || v > hi)
-    throw SceneError(node.loc_of(name), "'" + std::string(name) + "' of " + node.describe() + " must be in [" +
-                                               std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
-                                               std::to_string(v));
-  return v;
-}
 
 std::string lower(std::string s) {
   for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
@@ -40,14 +47,6 @@ std::shared_ptr<SceneNode> single_child(const SceneNode& node, const char* tag) 
   auto list = node.children_with_tag(tag);
   if (list.size() > 1) throw SceneError(list[1]->loc, node.describe() + " has more than one <" + std::string(tag) + ">");
   return list.empty() ? nullptr : list[0];
-}
-
-void report_extras(BuildState& st, const std::vector<std::shared_ptr<SceneNode>>& nodes, const char* what) {
-  for (size_t i = 1; i < nodes.size(); ++i) {
-    st.ctx.unsupported(nodes[i]->loc, "additional " + nodes[i]->describe(), std::string("ignored (the first ") + what +
-                                                                                " is used)");
-    st.reported.insert(nodes[i].get());
-  }
 }
 
 std::shared_ptr<const Filter> build_filter(BuildState& st, const SceneNode* film) {
@@ -223,75 +222,6 @@ void default_camera(BuildState& st) {
 }
 
 }  // namespace
-
-namespace {
-
-// Mitsuba integrators Tessera does not implement whose image a path tracer converges to as well
-// (except for paths it cannot sample): rendered by the (volume) path tracer with a note.
-bool substituted_by_path_tracer(const std::string& type) {
-  static const char* const kTypes[] = {"bdpt", "pssmlt", "mlt", "erpt", "ppm", "sppm", "photonmapper", "ptracer", "vpl"};
-  for (const char* t : kTypes)
-    if (type == t) return true;
-  return false;
-}
-
-}  // namespace
-
-void build_integrator(BuildState& st) {
-  auto nodes = st.desc.root->children_with_tag("integrator");
-  report_extras(st, nodes, "integrator");
-  const SceneNode* node = nodes.empty() ? nullptr : nodes[0].get();
-  const std::string& override_type = st.ctx.options().integrator;
-  // Mitsuba 0.x falls back to `direct` without an <integrator>; Mitsuba 2/3 to `path`.
-  std::string type = node ? node->type : (st.desc.version_major < 2 ? "direct" : "path");
-  IntegratorSettings& s = st.scene.integrator;
-  if (!override_type.empty()) {
-    if (override_type != "path" && override_type != "volpath" && override_type != "direct")
-      throw SceneError("unknown integrator '" + override_type + "' (use path, volpath or direct)");
-    if (node && node->type != override_type) {
-      st.ctx.note(node->loc, node->describe() + " replaced by the '" + override_type +
-                                 "' integrator given on the command line; its parameters are ignored");
-      st.reported.insert(node);
-      node = nullptr;
-    }
-    type = override_type;
-  }
-  if (node) node->used = true;
-  if (type == "path") {
-    s.type = IntegratorType::Path;
-  } else if (type == "volpath") {
-    s.type = IntegratorType::VolPath;  // finish_media() makes it path when there are no media
-  } else if (type == "direct") {
-    s.type = IntegratorType::Direct;
-  } else if (type == "guided_path") {
-    s.type = IntegratorType::Path;  // (the plugin is a surface path tracer)
-    read_guided_path(st, *node);
-  } else if (substituted_by_path_tracer(type)) {
-    st.ctx.note(node->loc, node->describe() + " is rendered by Tessera's path tracer (volpath where the scene has media): "
-                               "the same expected image, except for light paths a path tracer cannot sample, "
-                               "such as caustics of point lights seen through specular surfaces");
-    st.params_exempt.insert(node);  // its own parameters (photon counts, mutations...) mean nothing here
-    s.type = IntegratorType::VolPath;
-  } else {
-    st.ctx.unsupported(node->loc, node->describe(), fallback_for(*node));
-    st.reported.insert(node);
-    s.type = IntegratorType::VolPath;
-    return;
-  }
-  if (!node) return;
-  s.hide_emitters = node->get_bool("hide_emitters", false);
-  s.strict_normals = node->get_bool("strict_normals", false);
-  if (s.type != IntegratorType::Direct) {
-    s.max_depth = int(get_int_in(*node, "max_depth", -1, -1, 1 << 20));
-    s.rr_depth = int(get_int_in(*node, "rr_depth", 5, 1, 1 << 20));
-  } else {
-    int shading = int(get_int_in(*node, "shading_samples", 1, 0, 1 << 16));
-    s.emitter_samples = int(get_int_in(*node, "emitter_samples", shading, 0, 1 << 16));
-    s.bsdf_samples = int(get_int_in(*node, "bsdf_samples", shading, 0, 1 << 16));
-    if (s.emitter_samples + s.bsdf_samples == 0)
-      throw SceneError(node->loc, "the direct integrator needs emitter_samples or bsdf_samples > 0");
-  }
-}
 
 void read_shutter(BuildState& st) {
   auto sensors = st.desc.root->children_with_tag("sensor");

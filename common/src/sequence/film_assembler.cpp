@@ -146,6 +146,13 @@ std::vector<double> FilmAssembler::weights() const {
   return w;
 }
 
+Film FilmAssembler::take_film(int f) {
+  Film film = std::move(*films_[size_t(f)]);
+  if (!splats_[size_t(f)].empty())
+    film.set_splats(std::move(splats_[size_t(f)]), double(splat_paths_[size_t(f)]) / double(window_.area()));
+  return film;
+}
+
 // Film f's image over row y of the window (3 floats per pixel): its mean plus its splats.
 void FilmAssembler::pixel_row(int f, int y, std::vector<float>& row) const {
   const Film& film = *films_[size_t(f)];

@@ -21,6 +21,10 @@ std::string pass_error(const PassProgram& program, size_t p, const std::vector<b
     return where + "a Paths pass has no per-pixel counts or state";
   if (pass.tile_state && (p == 0 || program.passes[p - 1].kind != UnitKind::Tile))
     return where + "its per-pixel state comes from a Tile pass before it";
+  if (pass.same_samples &&
+      (pass.kind != UnitKind::Paths || p == 0 || program.passes[p - 1].kind != UnitKind::Tile ||
+       program.passes[p - 1].sample_begin != pass.sample_begin || program.passes[p - 1].samples != pass.samples))
+    return where + "traces the samples of a Tile pass just before it, which it does not follow";
   if (pass.adaptive && p == 0) return where + "the first pass has no film to adapt to";
   if (pass.uses && *pass.uses > 0 && !used_before[*pass.uses] && !pass.barrier)
     return where + "renders with a new artifact without waiting for it (a barrier)";
@@ -41,6 +45,7 @@ std::string program_error(const PassProgram& program) {
   }
   uint32_t next_sample = 0;  // the passes take the sample indices 0 .. spp-1 in order
   for (size_t p = 0; p < program.passes.size(); ++p) {
+    if (program.passes[p].same_samples && program.passes[p].kind == UnitKind::Paths) continue;  // (pass_error)
     if (program.passes[p].sample_begin != next_sample || program.passes[p].samples == 0)
       return "pass " + std::to_string(p) + ": its samples do not follow the pass before's";
     next_sample += program.passes[p].samples;

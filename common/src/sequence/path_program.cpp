@@ -17,7 +17,16 @@ std::optional<GuidePlan> guide_plan(const Scene& scene, std::optional<bool> requ
   return GuidePlan{scene.bounds(), settings.value_or(scene.integrator.guiding.value_or(GuidingSettings{}))};
 }
 
+std::string path_program_error(const PathProgramOptions& o) {
+  if (!o.light_paths) return {};
+  const char* what = o.target_error > 0 ? "a target error" : o.adaptive ? "adaptive sampling" : o.guide ? "path guiding" : nullptr;
+  if (!what) return {};
+  return std::string("this integrator traces light paths onto the film, whose noise is not in a pixel's own samples: ") +
+         what + " needs the path tracer (integrator path or volpath)";
+}
+
 PassProgram path_program(const PathProgramOptions& o) {
+  if (std::string e = path_program_error(o); !e.empty()) throw std::invalid_argument(e);
   PassProgram program;
   program.spp = o.spp;
   program.target_error = o.target_error;
@@ -47,6 +56,13 @@ PassProgram path_program(const PathProgramOptions& o) {
     const bool new_guide = pass.uses && *pass.uses > 0 && p <= training;
     pass.barrier = pass.may_stop || pass.adaptive || new_guide;
     program.passes.push_back(pass);
+    if (o.light_paths) {
+      PassSpec light = pass;
+      light.kind = UnitKind::Paths;
+      light.same_samples = true;
+      light.barrier = false;
+      program.passes.push_back(light);
+    }
   }
   return program;
 }

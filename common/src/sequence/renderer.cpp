@@ -7,6 +7,8 @@
 #include "tessera/sequence/path_program.h"
 
 #include <chrono>
+#include <stdexcept>
+#include <string>
 
 namespace tessera {
 
@@ -24,6 +26,14 @@ class PathUnits final : public UnitRenderer {
   }
 
   void render(const PassSequencer& sequencer, const UnitWork& work, UnitResult& result) override {
+    if (work.kind == UnitKind::Paths) {
+      thread_local LightSplats splats;
+      const SequenceFrame& f = sequencer.frame();
+      splats.reset(f.window, f.full_width, f.full_height);
+      trace_light_paths(scene_, work.path_begin, work.path_end, seed_, splats);
+      to_splat_sums(splats, result.splats);
+      return;
+    }
     std::optional<PathGuide> guide;
     if (work.uses) {
       const auto& tree = static_cast<const GuideArtifact*>(sequencer.artifact(*work.uses))->tree();
@@ -47,7 +57,12 @@ Film render(const Scene& scene, const RenderSettings& settings, const ProgressCa
   const auto start = std::chrono::steady_clock::now();
   TESSERA_CHECK(settings.spp >= 0 && settings.tile_size > 0);
   PathProgramOptions options{uint32_t(settings.spp), settings.target_error, settings.adaptive, settings.adaptive_settings,
-                             guide_plan(scene, settings.guiding, settings.guiding_settings)};
+                             guide_plan(scene, settings.guiding, settings.guiding_settings),
+                             traces_light_paths(scene.integrator)};
+  if (settings.aovs && is_bidirectional(scene.integrator.type))
+    throw std::invalid_argument("AOVs and denoising need the path tracer (integrator path or volpath): the " +
+                                std::string(scene.integrator.type == IntegratorType::Bdpt ? "bdpt" : "ptracer") +
+                                " integrator's light paths are not in a pixel's own samples");
   PassSequencer sequencer = path_sequencer(options, SequenceFrame{film_window(scene.film), scene.film.width,
                                                                   scene.film.height, settings.tile_size, settings.aovs});
   auto* training = dynamic_cast<GuideTraining*>(sequencer.builder());

@@ -28,6 +28,7 @@ struct ConvergenceOptions {
   int width = 0, height = 0;            // > 0: film size (the reference must match it)
   int threads = 0;                      // 0: all cores
   uint32_t seed = 0;                    // budget i renders with seed + i
+  std::string integrator;                // non-empty: overrides the scene's (LoadOptions::integrator)
   bool allow_unsupported = false;
 };
 

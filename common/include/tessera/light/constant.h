@@ -14,6 +14,9 @@ class ConstantLight final : public Light {
   bool sample_li(Vec3 ref_p, Vec2 u, LightSample& out) const override;
   Rgb le_env(Vec3 d) const override { return radiance_; }
   float pdf_env(Vec3 d) const override { return kInv4Pi; }
+  /// Uniform directions over the sphere, from the scene's disk (Light::sample_le).
+  bool sample_le(Vec2 u_pos, Vec2 u_dir, LightEmission& out) const override;
+  void pdf_le(Vec3 p, Vec3 n, Vec3 dir, float& pdf_pos, float& pdf_dir) const override;
   bool is_infinite() const override { return true; }
   /// 4 pi * pi R^2 * luminance: radiance L from every direction through a disk of the scene's
   /// cross-section (R: bounding-sphere radius, 1 before preprocess), as pbrt-v4's uniform

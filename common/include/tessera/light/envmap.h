@@ -44,6 +44,10 @@ class EnvmapLight final : public Light {
   Rgb deferred_li(const LightSample& s) const override { return lookup(s.li_uv); }
   Rgb le_env(Vec3 d) const override;
   float pdf_env(Vec3 d) const override;
+  /// Directions from the importance distribution (reversed: the way the light travels), from the
+  /// scene's disk; pdf_dir(dir) = pdf_env(-dir), le = le_env(-dir) (Light::sample_le).
+  bool sample_le(Vec2 u_pos, Vec2 u_dir, LightEmission& out) const override;
+  void pdf_le(Vec3 p, Vec3 n, Vec3 dir, float& pdf_pos, float& pdf_dir) const override;
   bool is_infinite() const override { return true; }
   /// Texels, row tables and the sampling distribution.
   size_t memory_bytes() const override {
@@ -63,6 +67,9 @@ class EnvmapLight final : public Light {
 
  private:
   Rgb texel(int x, int y) const { return texels_[size_t(y) * size_t(width_) + size_t(x)]; }
+  /// A light-space direction from the importance distribution, with its (u, v) and the solid-angle
+  /// density of the cell it was drawn from. False when the map is black.
+  bool sample_direction(Vec2 u, Vec3& d_light, Vec2& uv, float& pdf) const;
   /// Solid-angle density in light space at cell coordinates.
   float pdf_light(Vec3 d) const;
 

@@ -8,6 +8,7 @@
 
 #include "tessera/core/animated_transform.h"
 #include "tessera/core/ray.h"
+#include "tessera/core/rgb.h"
 #include "tessera/core/transform.h"
 #include "tessera/core/vec.h"
 
@@ -23,6 +24,11 @@ class Filter {
   virtual Vec2 sample(Vec2 u) const = 0;
   virtual float radius() const = 0;
   virtual std::string name() const = 0;
+  /// The filter's normalised kernel at `offset` from the pixel centre (in pixels): the density
+  /// sample() draws offsets with, integrating to 1 over [-radius, radius]^2. A sample of radiance
+  /// landing at raster point x counts in pixel (i, j) with weight eval(x - centre(i, j)) (light
+  /// tracing splats through it, so it converges to the image of the film's filtered samples).
+  virtual float eval(Vec2 offset) const = 0;
 };
 
 std::unique_ptr<Filter> make_box_filter(float radius = 0.5f);
@@ -40,9 +46,39 @@ struct FilmSettings {
   int crop_h() const { return crop_height > 0 ? crop_height : height; }
 };
 
+/// A point on the camera's lens seen from a reference point (Camera::sample_wi).
+struct CameraSampleWi {
+  Vec3 p_lens;     // world: the point on the lens (the pinhole for a pinhole camera)
+  Vec3 n;          // world: the camera's viewing direction (its +z), unit
+  Vec3 wi;         // unit, world: from the reference point towards p_lens
+  float dist = 0.f;  // from the reference point to p_lens
+  Rgb we;          // importance the camera gives the ray p_lens -> reference point (We)
+  float pdf = 0.f;   // density of p_lens per unit SOLID ANGLE at the reference point
+  Vec2 raster;     // where that ray crosses the film (raster space, above)
+};
+
 class Camera {
  public:
   virtual ~Camera() = default;
+  // Importance (light tracing and bidirectional methods), after pbrt-v4's PerspectiveCamera:
+  // We(p, w) = 1 / (A * lens_area * cos^4 theta) for rays that land on the film, 0 elsewhere, A the
+  // area of the whole film's image on the plane at distance 1 in front of the lens, theta the angle
+  // of w to the viewing direction; so We integrates to 1 over the film (per unit lens area).
+  /// Whether the methods below are implemented (perspective and thin lens cameras).
+  virtual bool has_importance() const { return false; }
+  /// We for the ray leaving the lens at ray.o along ray.d at time ray.time; where it crosses the film
+  /// into `raster` when not null. Black when it misses the film or points backwards.
+  virtual Rgb we(const Ray& ray, Vec2* raster) const { return {}; }
+  /// Densities with which generating rays over the whole film (uniform raster position, uniform lens
+  /// point) gives `ray`: pdf_pos per unit lens area (1 for a pinhole), pdf_dir per unit solid angle
+  /// (1 / (A cos^3 theta) on the film, 0 off it).
+  virtual void pdf_we(const Ray& ray, float& pdf_pos, float& pdf_dir) const {
+    pdf_pos = 0.f;
+    pdf_dir = 0.f;
+  }
+  /// Samples a point on the lens (from `u_lens`, as generate_ray does) that sees `ref_p` at `time`:
+  /// false when ref_p is behind the camera, closer than the near clip, or off the film.
+  virtual bool sample_wi(Vec3 ref_p, Vec2 u_lens, float time, CameraSampleWi& out) const { return false; }
   /// Ray through raster position `raster` (see above); `u_lens` for depth of field. Direction unit.
   virtual Ray generate_ray(Vec2 raster, Vec2 u_lens) const = 0;
   /// The ray at scene time `time` (motion blur); a camera that does not move just stamps the time.

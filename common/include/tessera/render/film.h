@@ -150,6 +150,13 @@ class Film {
 
   const RenderCounters& counters() const { return counters_; }
 
+  /// Light paths' splats (light tracing, bidirectional methods: sequence/splat_sums.h): 3 sums
+  /// per window pixel, from `paths_per_pixel` light paths per pixel. From then on a pixel's mean
+  /// is its samples' mean plus its splat sum over paths_per_pixel, rounded as FilmAssembler's image
+  /// rounds it (so the two are the same bits); the variance stays its samples'.
+  void set_splats(std::vector<double> sums, double paths_per_pixel);
+  bool has_splats() const { return !splats_.empty(); }
+
  private:
   size_t index(Vec2i p) const { return size_t(p.y - window_.y0) * size_t(window_.width()) + size_t(p.x - window_.x0); }
   void variance_rows(Image& img, int row_begin, int row_end) const;
@@ -158,6 +165,8 @@ class Film {
   std::vector<PixelSums> pixels_;
   std::vector<AovSums> aovs_;
   RenderCounters counters_;
+  std::vector<double> splats_;
+  double splat_paths_per_pixel_ = 0;
 };
 
 }  // namespace tessera

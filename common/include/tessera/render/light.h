@@ -40,6 +40,27 @@ struct LightSample {
   Vec2 li_uv;               // where deferred_li() looks the radiance up (the light's own map)
 };
 
+/// A ray leaving a light, for light tracing and bidirectional methods (Light::sample_le).
+/// The emitted weight of the sample is le * cos / (pdf_pos * pdf_dir), where cos = |dot(n, dir)| for
+/// area lights and 1 for every other kind (their le already is per unit area perpendicular to dir).
+struct LightEmission {
+  Vec3 p;        // where the light leaves: on an area light's surface, at a point or spot light,
+                 // or, for distant lights (envmap, sunsky, constant, directional), on a disk of the
+                 // scene's bounding sphere's radius, facing `dir`, one radius behind the sphere
+  Vec3 n;        // geometric normal at p (area lights, emitting side); `dir` for distant lights;
+                 // zero for point and spot lights
+  Vec3 p_error;  // rounding-error bound of p per axis (zero for points not on a surface)
+  Vec3 dir;      // unit, world: the direction the light travels
+  Rgb le;        // radiance leaving p along dir (area lights, environments); radiant intensity
+                 // towards dir (point, spot); irradiance on a plane facing it (directional)
+  float pdf_pos = 0.f;  // density of p per unit AREA (on the shape or on the disk); 1 for a delta
+                        // position (point, spot)
+  float pdf_dir = 0.f;  // density of dir per unit SOLID ANGLE given p; 1 for a delta direction
+                        // (directional)
+  bool delta_pos = false, delta_dir = false;
+  bool infinite = false;  // a distant light (p on the disk)
+};
+
 /// Where a light is sampled from: the shading point and, on surfaces, its (shading-side) normal;
 /// `n` is zero for points in a medium. Light selection may use both (a light hierarchy does).
 struct LightSampleContext {
@@ -65,6 +86,18 @@ class Light {
   virtual Rgb le_env(Vec3 d) const { return {}; }
   /// Infinite lights: solid-angle pdf of sample_li() choosing direction `d`.
   virtual float pdf_env(Vec3 d) const { return 0.f; }
+
+  /// Emission sampling: `u_pos` picks the point (for distant lights, the point on the disk),
+  /// `u_dir` the direction. False when the light emits nothing there (zero power, zero area).
+  virtual bool sample_le(Vec2 u_pos, Vec2 u_dir, LightEmission& out) const { return false; }
+  /// The densities sample_le() would have had for light leaving `p` (geometric normal `n`) in
+  /// direction `dir` (unit, world, the direction of travel): pdf_pos per unit area, pdf_dir per
+  /// unit solid angle. Distant lights ignore p and n (pdf_pos is the disk's). Zero where
+  /// sample_le() cannot produce that ray; delta components report 1 as above.
+  virtual void pdf_le(Vec3 p, Vec3 n, Vec3 dir, float& pdf_pos, float& pdf_dir) const {
+    pdf_pos = 0.f;
+    pdf_dir = 0.f;
+  }
 
   virtual bool is_infinite() const { return false; }
   virtual bool is_delta() const { return false; }

@@ -46,6 +46,14 @@ class LightSampler {
   /// The probability that sample(ctx, ...) returns `light` (0 for lights not chosen from).
   float pmf(const LightSampleContext& ctx, const Light* light) const;
 
+  /// Where light subpaths start (light tracing, bidirectional methods): a light in proportion to
+  /// its power whatever the strategy, and that probability; null when no light emits.
+  const Light* sample_emitter(float u, float& pmf) const {
+    pmf = 0.f;
+    return lights_.empty() ? nullptr : lights_[power_.sample(u, &pmf)];
+  }
+  float emitter_pmf(const Light* light) const { return selectable(light) ? power_.pmf(light->selection_index) : 0.f; }
+
   /// Everything sample() can return, in selection_index order.
   const std::vector<const Light*>& lights() const { return lights_; }
   const LightBvh& bvh() const { return bvh_; }

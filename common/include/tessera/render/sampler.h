@@ -15,6 +15,10 @@
 // time:        only when the shutter is open for a non-zero interval (motion blur), the camera ray's
 //              time from dimension kTimeDimension, read with sample_1d_at() so the counter, and
 //              thus every dimension above, is the same as without motion blur
+// bdpt/ptracer: the camera subpath as above (the light-pick and light-position dimensions feed
+//              next-event estimation); the light subpath from kLightDimension: light pick 1D,
+//              emission position 2D, emission direction 2D, then per bounce BSDF lobe 1D, BSDF
+//              direction 2D, Russian roulette 1D, lens 2D (the camera connection)
 // The direct integrator uses, per hit, (1D + 2D) per emitter sample then (1D + 2D) per BSDF sample.
 //
 // Types:
@@ -56,6 +60,11 @@ class Sampler {
   static constexpr uint32_t kTimeDimension = 0xFFFFFF00u;
 
   uint32_t dimension() const { return dim_; }
+  /// Moves the counter to `dim`: a block of dimensions of its own (kLightDimension).
+  void set_dimension(uint32_t dim) { dim_ = dim; }
+  /// Where light subpaths of bidirectional methods start drawing (bdpt.h), far from the camera
+  /// path's dimensions, so a pixel sample's light subpath is the same whichever unit traces it.
+  static constexpr uint32_t kLightDimension = 0x40000000u;
   SamplerType type() const { return type_; }
   uint32_t seed() const { return seed_; }
 

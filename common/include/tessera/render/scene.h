@@ -25,7 +25,9 @@ namespace tessera {
 
 // VolPath is the path tracer that also tracks participating media; the loader turns it into Path
 // on a scene without media (the same image, minus the sampler dimensions media would consume).
-enum class IntegratorType { Path, VolPath, Direct };
+// Bdpt and Ptracer (bidirectional path tracing, light tracing: bdpt.h) trace surfaces only; a scene
+// with media asked for them is rendered by VolPath with a note.
+enum class IntegratorType { Path, VolPath, Direct, Bdpt, Ptracer };
 // How path/volpath estimate direct light (integrator.h states each rule); Direct ignores it.
 enum class SamplingStrategy { Mis, Bsdf, Nee };
 
@@ -38,6 +40,14 @@ struct IntegratorSettings {
   // direct integrator only
   int emitter_samples = 1;
   int bsdf_samples = 1;
+  // bdpt only (Mitsuba 0.6's names): lightImage, the strategies that connect light subpaths to the
+  // camera (t = 1); sampleDirect, next-event estimation (s = 1). Off: left out of the estimator and
+  // of its MIS weights.
+  bool light_image = true;
+  bool sample_direct = true;
+  // bdpt, for tests and debugging (never read from files): only strategy (s, t) (bdpt.h), with
+  // weight 1; every other strategy adds nothing. s = -1: all of them, MIS-weighted.
+  int only_s = -1, only_t = -1;
   // How next-event estimation picks a light (render/light_sampler.h); read by Scene::finalize.
   LightSelection light_selection = LightSelection::Bvh;
   SamplingStrategy strategy = SamplingStrategy::Mis;  // path/volpath only; not read from scene files

@@ -64,8 +64,8 @@ class FilmAssembler {
   void release();
   /// Film `f` (allocated()).
   const Film& film(int f) const { return *films_[size_t(f)]; }
-  /// Moves film `f` out (a finished local render; the assembler is spent).
-  Film take_film(int f) { return std::move(*films_[size_t(f)]); }
+  /// Moves film `f` out with its splats (a finished local render; the assembler is spent).
+  Film take_film(int f);
   int primary_film() const { return primary_; }
 
   /// The estimate of the image's relMSE (Sum: film 0's; InverseVariance: 1 / the sum of the films'

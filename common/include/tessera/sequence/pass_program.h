@@ -64,6 +64,11 @@ struct PassSpec {
   /// (Tile) Unit (p, t) starts from the per-pixel state unit (p-1, t) of the same tile left (a
   /// photon mapper's radii and counts): it is ready once that unit is done, without a barrier.
   bool tile_state = false;
+  /// (Paths) Traces the light subpaths of the pixel samples of the Tile pass just before it (the
+  /// same sample_begin and samples; path k is sample k / window pixels of window pixel k mod window
+  /// pixels, row-major): a bidirectional method's light tracing. It takes no sample indices of its
+  /// own, so the passes' samples still add up to spp.
+  bool same_samples = false;
   bool operator==(const PassSpec&) const = default;
 };
 

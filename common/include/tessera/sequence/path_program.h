@@ -11,6 +11,7 @@
 #include "tessera/sequence/pass_sequencer.h"
 
 #include <optional>
+#include <string>
 
 namespace tessera {
 
@@ -34,14 +35,22 @@ struct PathProgramOptions {
   bool adaptive = false;
   AdaptiveSettings adaptive_settings;
   std::optional<GuidePlan> guide;
+  /// Light tracing (render/bdpt.h traces_light_paths): each Tile pass is followed by a Paths pass
+  /// of the same samples (PassSpec::same_samples) that splats its light subpaths onto the film.
+  bool light_paths = false;
 };
+
+/// Why `options` cannot be run, or empty: light tracing has no per-pixel noise estimate for a
+/// target error or adaptive sampling, and no guide.
+std::string path_program_error(const PathProgramOptions& options);
 
 /// The program: with a target error every pass after the first may stop the render. Adaptive: the
 /// passes that adaptive_pass() allows, and all after them, are barriers with adaptive counts.
 /// Guided: the training passes (guiding_trains_pass) render with the guide learned so far (pass p
 /// with iteration p) and feed the next, pass p > 0 waits for the guide it renders with, and every
 /// later pass renders with the last; with discard_training the training passes enter no film.
-/// Without a training pass (fewer than 2 samples a pixel) nothing is guided.
+/// Without a training pass (fewer than 2 samples a pixel) nothing is guided. Throws
+/// std::invalid_argument with path_program_error()'s reason.
 PassProgram path_program(const PathProgramOptions& options);
 
 /// The sequencer of that program over `frame`, with the guide's training (guide_training.h) as its

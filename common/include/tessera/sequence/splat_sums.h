@@ -6,6 +6,7 @@
 
 #include "tessera/core/rgb.h"
 #include "tessera/core/vec.h"
+#include "tessera/render/bdpt.h"
 #include "tessera/render/film.h"
 
 #include <array>
@@ -37,5 +38,20 @@ struct SplatSums {
   }
   size_t size() const { return pixel.size(); }
 };
+
+/// A light-tracing unit's splats (render/bdpt.h) as its result: one splat per touched pixel, in
+/// pixel order (a function of the unit's paths alone).
+inline void to_splat_sums(const LightSplats& in, SplatSums& out) {
+  out.reset(in.window());
+  out.counters = in.counters;
+  const std::vector<uint32_t> touched = in.sorted_touched();
+  out.pixel.reserve(touched.size());
+  out.value.reserve(touched.size());
+  for (uint32_t i : touched) {
+    const double* s = in.sum(i);
+    out.pixel.push_back(i);
+    out.value.push_back({s[0], s[1], s[2]});
+  }
+}
 
 }  // namespace tessera

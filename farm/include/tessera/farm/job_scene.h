@@ -4,6 +4,8 @@
 // the same parse_scene_file/load_scene with the same options, timing each step itself.)
 #pragma once
 
+#include "tessera/farm/splat_result.h"
+
 #include "tessera/farm/protocol.h"
 #include "tessera/farm/tile_result.h"
 #include "tessera/guiding/spatial_tree.h"
@@ -68,6 +70,10 @@ void begin_tile_result(const Lease& lease, TileResult& out);
 /// Renders a lease's unit (what a worker does with it), timed. A guided lease needs its guide
 /// (Lease::guide, decoded): a unit that trains returns its training records with the result.
 TileResult render_lease(const Scene& scene, const Lease& lease, const SpatialTree* guide = nullptr);
+/// Renders a lease of light paths (Lease::paths) of a light-tracing integrator (render/bdpt.h):
+/// the splats its paths add to the film's window. Throws std::invalid_argument for a lease that
+/// is not one, or a scene whose integrator traces no light paths.
+SplatResult render_paths_lease(const Scene& scene, const Lease& lease);
 
 nlohmann::json to_json(const JobPlan& p);
 [[nodiscard]] bool job_plan_from_json(const nlohmann::json& j, JobPlan& out, std::string& error);

@@ -31,13 +31,18 @@ struct SplatResult {
   std::string records;  // for the artifact the unit feeds (empty if it feeds none)
 };
 
-/// A light path adds at most this many splats (one per vertex a camera connection starts from):
-/// what bounds an upload of a range of paths.
+/// A light path adds at most this many splats (one per vertex a camera connection starts from),
+/// or a result sums its paths' splats per pixel (a light tracer's: one splat per window pixel at
+/// most): what bounds an upload of a range of paths over a window.
 inline constexpr uint64_t kMaxSplatsPerPath = 64;
+inline uint64_t max_splats(uint64_t paths, uint64_t window_pixels) {
+  if (paths == 0) return 0;
+  return paths * kMaxSplatsPerPath > window_pixels ? paths * kMaxSplatsPerPath : window_pixels;
+}
 
-/// The most bytes a result of `paths` light paths can take as sent, with records of at most
-/// `max_record_bytes`.
-uint64_t max_splat_result_bytes(uint64_t paths, uint64_t max_record_bytes);
+/// The most bytes a result of `paths` light paths over a window of `window_pixels` can take as
+/// sent, with records of at most `max_record_bytes`.
+uint64_t max_splat_result_bytes(uint64_t paths, uint64_t max_record_bytes, uint64_t window_pixels = 0);
 
 /// Whether `bytes` (compressed or not) are a splat result rather than a tile result.
 bool is_splat_result(std::string_view bytes);
@@ -47,7 +52,7 @@ std::string encode_splat_result(const SplatResult& result, int level = 1);
 
 /// Decodes and verifies bytes. False with `error` set on anything malformed: bad compression,
 /// magic, version or checksum, a size that does not match its counts, a pixel outside the window,
-/// more splats than kMaxSplatsPerPath a path, a window of more than `max_pixels`.
+/// more splats than max_splats(), a window of more than `max_pixels`.
 [[nodiscard]] bool decode_splat_result(std::string_view bytes, SplatResult& out, std::string& error,
                                        int64_t max_pixels = int64_t(1) << 28);
 

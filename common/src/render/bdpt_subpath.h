@@ -1,0 +1,76 @@
+// Internals of bdpt.h: subpath vertices, their MIS quantities and the light subpath.
+//
+// MIS (Georgiev 2012, power heuristic): every vertex carries
+//   d_vcm  1 / (density with which the subpath's own direction sampled this vertex, area measure),
+//          times the weight ratio of the strategy that would have ended the other subpath here;
+//   d_vc   the sum of the ratios of the strategies with more vertices on the other side.
+// Both are squared quantities already (mis()). A strategy's weight is 1 / (1 + the ratios of every
+// other strategy), each ratio built from these at the two ends of the connection.
+#pragma once
+
+#include "tessera/render/bdpt.h"
+#include "tessera/render/interaction.h"
+
+#include <vector>
+
+namespace tessera::bdpt {
+
+/// The power heuristic's exponent (2), applied to a density ratio.
+inline float mis(float x) { return x * x; }
+
+/// The weight of strategy (s, t) (s light vertices, t camera vertices): its MIS weight, or with
+/// IntegratorSettings::only_s set, 1 for that one strategy and 0 for every other.
+inline float strategy_weight(const IntegratorSettings& settings, int s, int t, float mis_weight) {
+  if (settings.only_s < 0) return mis_weight;
+  return s == settings.only_s && t == settings.only_t ? 1.f : 0.f;
+}
+
+/// Adjoint (importance) evaluation at a light vertex: light arrives from `w_prev` (world, towards
+/// the previous light vertex) and leaves towards `w_next`. The BSDF with its arguments swapped
+/// (so a refraction's radiance scaling is undone), times Veach's shading-normal correction; as
+/// eval(), it includes the cosine of w_next. Zero when either direction is on the wrong side.
+Rgb adjoint_eval(const SurfaceInteraction& si, const Bsdf& bsdf, Vec3 w_prev, Vec3 w_next);
+/// The importance weight of a sampled direction: bs.weight (radiance) made adjoint: times eta^2
+/// for a refraction and the shading-normal correction.
+Rgb adjoint_weight(const SurfaceInteraction& si, const BsdfSample& bs, Vec3 w_prev, Vec3 w_next);
+
+struct Vertex {
+  SurfaceInteraction si;
+  const Bsdf* bsdf = nullptr;
+  Vec3 wo;         // local: towards the previous vertex of its subpath
+  Vec3 wo_world;
+  Rgb beta;        // light: emitted power along the subpath; camera: throughput
+  int length = 0;  // segments from the subpath's origin
+  float d_vcm = 0.f, d_vc = 0.f;
+  Vec2 u_lens;     // light vertices: the lens sample of its camera connection
+};
+
+/// Where light subpaths start, as sample_le() gave it.
+struct LightOrigin {
+  const Light* light = nullptr;
+  LightEmission emission;
+  float emission_pdf = 0.f;  // pick pmf * pdf_pos * pdf_dir
+  bool delta = false;        // delta position or direction
+};
+
+/// A light subpath's non-delta surface vertices, in order (lengths increasing).
+struct LightSubpath {
+  LightOrigin origin;
+  std::vector<Vertex> vertices;
+};
+
+/// Traces the light subpath of the sampler's pixel sample from Sampler::kLightDimension, up to
+/// the length a path of at most settings.max_depth segments can use; the sampler's dimension is
+/// restored afterwards.
+void trace_light_subpath(const Scene& scene, const IntegratorSettings& settings, Sampler& sampler, float time,
+                         LightSubpath& out, RenderCounters& counters);
+
+/// Next-event estimation's density at the surface point `si` of picking the subpath's origin: per
+/// unit area at the origin for finite lights, per unit solid angle for distant ones, the light's
+/// selection pmf alone for a delta position or direction.
+float direct_pdf(const Scene& scene, const SurfaceInteraction& si, const LightOrigin& origin);
+
+/// The scene's time for a pixel sample (motion blur), as render_tile gives it to the camera ray.
+float sample_time(const Scene& scene, Sampler& sampler);
+
+}  // namespace tessera::bdpt
