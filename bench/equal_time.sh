@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Path guiding and adaptive sampling at equal time (docs/performance.md, "Guiding and adaptive
-# sampling"): every shared scene at its reference's resolution, each configuration rendered with the
+# Path guiding, adaptive sampling and the bidirectional integrators at equal time
+# (docs/performance.md, "Guiding and adaptive sampling", "Bidirectional path tracing"): every shared scene at its reference's resolution, each configuration rendered with the
 # same spp and several seeds; per run the render's seconds, its relMSE against ../shared/references/,
 # the same without the worst 0.1% of pixels, and the reference's own noise floor (what relMSE gains
 # from the reference's noise: `tessera compare --variance`, ref_floor). Per scene and configuration
@@ -14,7 +14,8 @@
 #
 # Usage: bench/equal_time.sh [BUILD_DIR] [SPP]      (defaults: build, 128)
 # Environment: ET_SCENES="cornell-box ..." (default all seven)  ET_SEEDS="1 2 3"
-#   ET_CONFIGS="plain adaptive guided guided+adaptive"  ET_THREADS=2  ET_OUT=docs/performance
+#   ET_CONFIGS="plain adaptive guided guided+adaptive" (also: bdpt, ptracer: the path tracer's
+#   passes by `--integrator bdpt|ptracer`, keeping the scene's depths)  ET_THREADS=2  ET_OUT=docs/performance
 #   TESSERA=path/to/tessera (default BUILD_DIR/cli/tessera)
 #   ET_TABLE_ONLY=1: render nothing, make the table again from OUT/equal_time.csv
 # A missing scene or reference is an error (exit 1), never a skip.
@@ -45,17 +46,19 @@ csv="$out/equal_time.csv"
 for s in ${scenes[@]+"${scenes[@]}"}; do
   res=$(grep -o 'Resolution [0-9]*×[0-9]*' "$shared/references/$s/README.md" | grep -o '[0-9][0-9]*')
   w=$(echo "$res" | sed -n 1p); h=$(echo "$res" | sed -n 2p)
-  extra=()
+  extra=() path=()
   # Its reference was rendered with `path`; its sky is seen through window glass (docs/performance.md).
-  [ "$s" = kitchenette ] && extra=(--integrator path --allow-unsupported)
+  [ "$s" = kitchenette ] && extra=(--allow-unsupported) path=(--integrator path)
   for seed in "${seeds[@]}"; do
     for c in "${configs[@]}"; do
-      guiding=off adaptive=off
+      guiding=off adaptive=off integrator=("${path[@]}")
       case "$c" in
         plain) ;; adaptive) adaptive=on ;; guided) guiding=on ;; guided+adaptive) guiding=on adaptive=on ;;
+        bdpt|ptracer) integrator=(--integrator "$c") ;;
         *) echo "equal_time.sh: unknown configuration '$c'" >&2; exit 1 ;;
       esac
-      "$tessera" render "$shared/scenes/$s/scene.xml" "${extra[@]}" --width "$w" --height "$h" --spp "$spp" \
+      "$tessera" render "$shared/scenes/$s/scene.xml" ${extra[@]+"${extra[@]}"} ${integrator[@]+"${integrator[@]}"} \
+        --width "$w" --height "$h" --spp "$spp" \
         --seed "$seed" --threads "$threads" --guiding "$guiding" --adaptive "$adaptive" -q -o "$tmp/img.exr" \
         2> "$tmp/log"
       secs=$(grep -o 'render [0-9.e+-]* s' "$tmp/log" | tail -1 | awk '{print $2}')

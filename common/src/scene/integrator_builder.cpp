@@ -5,6 +5,7 @@
 
 #include "scene/builder_internal.h"
 
+#include <algorithm>
 #include <iterator>
 #include <optional>
 
@@ -95,6 +96,17 @@ void read_ptracer(BuildState& st, const SceneNode& node, IntegratorSettings& s) 
                        "false (every light vertex is connected to the camera)");
 }
 
+// An integrator given on the command line in place of one that traces paths of a bounded depth
+// keeps that depth: the same light paths, by another method (what comparisons of methods need).
+bool keep_depths(const SceneNode& node, IntegratorSettings& s) {
+  static const char* const kTracers[] = {"path", "volpath", "guided_path", "bdpt", "ptracer"};
+  if (std::none_of(std::begin(kTracers), std::end(kTracers), [&](const char* t) { return node.type == t; }) &&
+      !substituted_by_path_tracer(node.type))
+    return false;
+  read_depths(node, s, name_in(node, "max_depth", "maxDepth"), name_in(node, "rr_depth", "rrDepth"));
+  return true;
+}
+
 void read_parameters(BuildState& st, const SceneNode& node, IntegratorSettings& s) {
   switch (s.type) {
     case IntegratorType::Direct: read_direct(node, s); break;
@@ -124,8 +136,11 @@ void build_integrator(BuildState& st) {
   if (!override_type.empty()) {
     if (!own_type(override_type)) throw SceneError("unknown integrator '" + override_type + "' (use " + own_names() + ")");
     if (node && node->type != override_type) {
+      const bool depths = keep_depths(*node, s);
       st.ctx.note(node->loc, node->describe() + " replaced by the '" + override_type +
-                                 "' integrator given on the command line; its parameters are ignored");
+                                 "' integrator given on the command line; " +
+                                 (depths ? "it keeps its maximum and Russian roulette depths, its other parameters are ignored"
+                                         : "its parameters are ignored"));
       st.reported.insert(node);
       node = nullptr;
     }

@@ -57,10 +57,10 @@ struct PassSpec {
   /// The film its results enter (0 .. films-1), or kNoFilm.
   int film = 0;
   /// The artifact iteration its units render with (see ArtifactBuilder), if any.
-  std::optional<uint32_t> uses;
+  std::optional<uint32_t> uses = std::nullopt;
   /// The artifact iteration its units' records go into, if any: made at the barrier of the first
   /// pass that uses it, from the iteration before and every record of the passes that feed it.
-  std::optional<uint32_t> feeds;
+  std::optional<uint32_t> feeds = std::nullopt;
   /// (Tile) Unit (p, t) starts from the per-pixel state unit (p-1, t) of the same tile left (a
   /// photon mapper's radii and counts): it is ready once that unit is done, without a barrier.
   bool tile_state = false;
