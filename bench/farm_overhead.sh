@@ -15,6 +15,8 @@ tile=${4:-32}
 adaptive=${5:-off}
 guiding=${6:-off}
 scene=${7:-../shared/scenes/cornell-box/scene.xml}
+integrator=()
+[ -n "${8:-}" ] && integrator=(--integrator "$8")
 cores=$(nproc)
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
@@ -22,10 +24,10 @@ now() { date +%s.%N; }
 
 t0=$(now)
 "$build/cli/tessera" render "$scene" --spp "$spp" --width "$size" --height "$size" --tile-size "$tile" -q \
-    --adaptive "$adaptive" --guiding "$guiding" -o "$tmp/local.exr" 2> /dev/null
+    --adaptive "$adaptive" --guiding "$guiding" ${integrator[@]+"${integrator[@]}"} -o "$tmp/local.exr" 2> /dev/null
 local_s=$(echo "$(now) - $t0" | bc -l)
-printf "%s %dx%d %d spp, %d cores, tile %d, adaptive %s, guiding %s\n" "$(basename "$(dirname "$scene")")" "$size" \
-    "$size" "$spp" "$cores" "$tile" "$adaptive" "$guiding"
+printf "%s %dx%d %d spp, %d cores, tile %d, adaptive %s, guiding %s, integrator %s\n" "$(basename "$(dirname "$scene")")" \
+    "$size" "$size" "$spp" "$cores" "$tile" "$adaptive" "$guiding" "${8:-as the scene says}"
 printf "%-28s %8.2f s\n" "tessera render ($cores threads)" "$local_s"
 
 for workers in 1 2; do
@@ -41,7 +43,8 @@ for workers in 1 2; do
   read -r u0 s0 < <(awk '{print $14, $15}' "/proc/$server/stat")
   t0=$(now)
   "$build/cli/tessera" submit "$scene" --server "$url" --spp "$spp" --width "$size" --height "$size" \
-      --tile-size "$tile" --adaptive "$adaptive" --guiding "$guiding" -q -o "$data/farm.exr" 2> /dev/null > /dev/null
+      --tile-size "$tile" --adaptive "$adaptive" --guiding "$guiding" ${integrator[@]+"${integrator[@]}"} -q \
+      -o "$data/farm.exr" 2> /dev/null > /dev/null
   wall=$(echo "$(now) - $t0" | bc -l)
   read -r u1 s1 < <(awk '{print $14, $15}' "/proc/$server/stat")
   status=$(curl -sf "$url/api/v1/jobs/1")

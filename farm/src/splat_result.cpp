@@ -45,10 +45,11 @@ uint64_t max_splat_result_bytes(uint64_t paths, uint64_t max_record_bytes, uint6
 
 bool is_splat_result(std::string_view bytes) {
   if (bytes.size() >= 4 && std::memcmp(bytes.data(), kMagic, 4) == 0) return true;
-  // Compressed: the first four bytes it decompresses to (a stream stops once they are out).
+  // Compressed: the first four bytes it decompresses to (a stream stops once they are out). They
+  // come out with the frame's first block, which can take up to a block's size (128 KiB) of input.
   char head[4];
   ZSTD_DCtx* d = ZSTD_createDCtx();
-  ZSTD_inBuffer in{bytes.data(), std::min<size_t>(bytes.size(), 1 << 16), 0};
+  ZSTD_inBuffer in{bytes.data(), std::min<size_t>(bytes.size(), ZSTD_BLOCKSIZE_MAX + 4096), 0};
   ZSTD_outBuffer out{head, sizeof(head), 0};
   for (int step = 0; step < 64 && out.pos < out.size && in.pos < in.size; ++step)
     if (ZSTD_isError(ZSTD_decompressStream(d, &out, &in))) break;

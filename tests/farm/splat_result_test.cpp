@@ -64,6 +64,19 @@ TEST(SplatResult, RoundTripsCompressedAndStored) {
   EXPECT_FALSE(is_splat_result("junk"));
 }
 
+// A light tracer's unit over a large window: megabytes of random-looking doubles, whose first
+// compressed block takes more than 64 KiB before it gives the magic out.
+TEST(SplatResult, ALargeResultIsToldApartFromATile) {
+  const SplatResult r = sample_result(200000);
+  const std::string bytes = encode_splat_result(r);
+  ASSERT_GT(bytes.size(), size_t(1) << 20);
+  EXPECT_TRUE(is_splat_result(bytes));
+  SplatResult back;
+  std::string error;
+  ASSERT_TRUE(decode_splat_result(bytes, back, error)) << error;
+  expect_equal(r, back);
+}
+
 TEST(SplatResult, DamageAndSplatsOutsideTheirBoundsAreRefused) {
   const SplatResult r = sample_result(40);
   const std::string stored = encode_splat_result(r, kUncompressed);

@@ -258,16 +258,9 @@ TEST(PassProgram, APassOfTheSameSamplesFollowsItsTilePass) {
   PassProgram p;
   p.spp = 5;
   p.paths_per_unit = 50;
-  auto pass = [](UnitKind kind, uint32_t begin, uint32_t samples, bool same) {
-    PassSpec s;
-    s.kind = kind;
-    s.sample_begin = begin;
-    s.samples = samples;
-    s.same_samples = same;
-    return s;
-  };
-  p.passes = {pass(UnitKind::Tile, 0, 2, false), pass(UnitKind::Paths, 0, 2, true), pass(UnitKind::Tile, 2, 3, false),
-              pass(UnitKind::Paths, 2, 3, true)};
+  p.passes = {pass_of_kind(UnitKind::Tile, 0, 2), pass_of_kind(UnitKind::Paths, 0, 2), pass_of_kind(UnitKind::Tile, 2, 3),
+              pass_of_kind(UnitKind::Paths, 2, 3)};
+  p.passes[1].same_samples = p.passes[3].same_samples = true;
   ASSERT_EQ(program_error(p), "");
   const PassSequencer seq(p, toy_frame(8));
   const uint64_t pixels = uint64_t(seq.frame().window.area());

@@ -27,6 +27,16 @@ inline SequenceFrame toy_frame(int tile_size) { return SequenceFrame{TileRect{3,
 ///   5 Paths   samples 13-16  film 1  iteration 1, feeds 2
 ///   6 Tile    samples 17-20  film 1  barrier: adaptive, iteration 2
 ///   7 Tile    samples 21-24  film 1  barrier: adaptive, iteration 2, state from pass 6
+/// A pass of `kind` over samples [begin, begin + n) into `film`.
+inline PassSpec pass_of_kind(UnitKind kind, uint32_t begin, uint32_t n, int film = 0) {
+  PassSpec s;
+  s.kind = kind;
+  s.sample_begin = begin;
+  s.samples = n;
+  s.film = film;
+  return s;
+}
+
 inline PassProgram everything_program() {
   PassProgram p;
   p.spp = 25;
@@ -34,14 +44,7 @@ inline PassProgram everything_program() {
   p.combine = FilmCombine::InverseVariance;
   p.paths_per_unit = 53;
   p.adaptive_settings.min_samples = 2;
-  auto pass = [](UnitKind kind, uint32_t begin, uint32_t n, int film) {
-    PassSpec s;
-    s.kind = kind;
-    s.sample_begin = begin;
-    s.samples = n;
-    s.film = film;
-    return s;
-  };
+  const auto pass = pass_of_kind;
   p.passes = {pass(UnitKind::Tile, 0, 2, 0),  pass(UnitKind::Tile, 2, 2, 0),   pass(UnitKind::Paths, 4, 4, 0),
               pass(UnitKind::Tile, 8, 2, 0),  pass(UnitKind::Tile, 10, 3, 1),  pass(UnitKind::Paths, 13, 4, 1),
               pass(UnitKind::Tile, 17, 4, 1), pass(UnitKind::Tile, 21, 4, 1)};

@@ -1,6 +1,7 @@
 // The camera's half of bidirectional path tracing (bdpt.h): every strategy with t >= 2 for one
 // pixel sample, and the light tracer's directly visible emitters.
 #include "render/bdpt_subpath.h"
+#include "render/bounce_samples.h"
 
 #include <algorithm>
 #include <cmath>
@@ -19,24 +20,6 @@ struct CameraPath {
   float d_vcm = 0.f, d_vc = 0.f;
   LightSampleContext prev_ctx;
   float time = 0.f;
-};
-
-// The dimensions of one camera bounce, in `path`'s layout (sampler.h).
-struct BounceSamples {
-  float u_pick;
-  Vec2 u_light;
-  float u_lobe;
-  Vec2 u_dir;
-  float u_rr;
-  static BounceSamples draw(Sampler& sampler) {
-    BounceSamples b;
-    b.u_pick = sampler.next_1d();
-    b.u_light = sampler.next_2d();
-    b.u_lobe = sampler.next_1d();
-    b.u_dir = sampler.next_2d();
-    b.u_rr = sampler.next_1d();
-    return b;
-  }
 };
 
 // What a camera vertex needs besides its interaction.
@@ -183,7 +166,7 @@ class BdptIntegrator final : public Integrator {
       if (!consistent_side(si, dir, wi)) continue;
       const Rgb f_camera = v.bsdf->eval(si, v.wo, wi);
       if (f_camera.is_black()) continue;
-      const Rgb f_light = bdpt::adjoint_eval(lv.si, *lv.bsdf, lv.wo_world, -dir);
+      const Rgb f_light = adjoint_eval(lv.si, *lv.bsdf, lv.wo_world, -dir);
       if (f_light.is_black()) continue;
       const Vec3 wl = lv.si.to_local(-dir);
       const float pdf_c_fwd = v.bsdf->pdf(si, v.wo, wi), pdf_c_rev = v.bsdf->pdf(si, wi, v.wo);

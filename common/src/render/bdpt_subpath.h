@@ -9,6 +9,7 @@
 #pragma once
 
 #include "tessera/render/bdpt.h"
+#include "tessera/render/bsdf_adjoint.h"
 #include "tessera/render/interaction.h"
 
 #include <vector>
@@ -24,15 +25,6 @@ inline float strategy_weight(const IntegratorSettings& settings, int s, int t, f
   if (settings.only_s < 0) return mis_weight;
   return s == settings.only_s && t == settings.only_t ? 1.f : 0.f;
 }
-
-/// Adjoint (importance) evaluation at a light vertex: light arrives from `w_prev` (world, towards
-/// the previous light vertex) and leaves towards `w_next`. The BSDF with its arguments swapped
-/// (so a refraction's radiance scaling is undone), times Veach's shading-normal correction; as
-/// eval(), it includes the cosine of w_next. Zero when either direction is on the wrong side.
-Rgb adjoint_eval(const SurfaceInteraction& si, const Bsdf& bsdf, Vec3 w_prev, Vec3 w_next);
-/// The importance weight of a sampled direction: bs.weight (radiance) made adjoint: times eta^2
-/// for a refraction and the shading-normal correction.
-Rgb adjoint_weight(const SurfaceInteraction& si, const BsdfSample& bs, Vec3 w_prev, Vec3 w_next);
 
 struct Vertex {
   SurfaceInteraction si;

@@ -69,7 +69,7 @@ namespace {
 void connect_to_camera(const Scene& scene, const bdpt::Vertex& v, float time, bool weighted, LightSplats& out) {
   CameraSampleWi cs;
   if (!scene.camera->sample_wi(v.si.p, v.u_lens, time, cs) || !(cs.pdf > 0.f)) return;
-  const Rgb f = bdpt::adjoint_eval(v.si, *v.bsdf, v.wo_world, cs.wi);
+  const Rgb f = adjoint_eval(v.si, *v.bsdf, v.wo_world, cs.wi);
   if (f.is_black() || cs.we.is_black()) return;
   float w = 1.f;
   if (weighted && scene.integrator.only_s < 0) {

@@ -7,6 +7,8 @@
 // continues in a phase-sampled direction, and `null` surfaces only switch the medium. Shadow rays
 // carry the medium's transmittance (Scene::transmittance with a medium). Transmittance is the same
 // factor for both strategies that can reach a light, so the MIS weights use the directional pdfs.
+#include "render/bounce_samples.h"
+
 #include "tessera/core/frame.h"
 #include "tessera/core/sampling.h"
 #include "tessera/render/guided_sampling.h"
@@ -33,25 +35,6 @@ struct Vertex {
   const Medium* medium = nullptr;  // medium around the vertex (on a surface: resolved per light side)
   const DirectionalTree* guide = nullptr;  // a guided surface vertex: its scattering pdf is the mixture's
   float bsdf_fraction = 1.f;
-};
-
-// The dimensions of one bounce, drawn in one fixed layout whether used or not (see sampler.h), so
-// that a pixel's later bounces see the same dimensions whatever happened before.
-struct BounceSamples {
-  float u_pick;   // light selection
-  Vec2 u_light;   // a point on the light
-  float u_lobe;   // the BSDF's lobe (unused by phase functions)
-  Vec2 u_dir;     // the scattered direction
-  float u_rr;     // Russian roulette
-  static BounceSamples draw(Sampler& sampler) {
-    BounceSamples b;
-    b.u_pick = sampler.next_1d();
-    b.u_light = sampler.next_2d();
-    b.u_lobe = sampler.next_1d();
-    b.u_dir = sampler.next_2d();
-    b.u_rr = sampler.next_1d();
-    return b;
-  }
 };
 
 // A path under construction: the radiance gathered so far and what the next step needs.

@@ -48,7 +48,7 @@ struct JobRow {
 
 struct WorkerRow {
   uint64_t id = 0;
-  std::string name, version, isa;
+  std::string name, version = {}, isa = {};
   int threads = 0;
   uint64_t memory = 0;
   double registered = 0;
