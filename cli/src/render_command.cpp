@@ -1,5 +1,6 @@
 // `tessera render`: parse -> load (meshes, images, BVH) -> render -> write, with timings.
 #include "render_output.h"
+#include "strategy_images.h"
 
 #include "tessera/cli/command_line.h"
 #include "tessera/cli/commands.h"
@@ -101,18 +102,13 @@ RenderSettings render_settings(const RenderOptions& options, const Scene& scene,
   return settings;
 }
 
-// Renders with a progress bar that weighs tiles by their pass's samples (later passes are longer).
+// Renders with a progress bar in samples per pixel, moving with the work done (later passes are
+// longer; a light tracer's passes of paths count as much as their samples).
 Film render_with_progress(const Scene& scene, const RenderSettings& settings, bool quiet, RenderStats& stats) {
-  const std::vector<uint32_t> passes = pass_schedule(uint32_t(settings.spp));
   Progress progress("render", !quiet);
   Film film = render(
       scene, settings,
-      [&](const RenderProgress& p) {
-        const double tiles_per_pass = double(p.tiles_total) / std::max(p.num_passes, 1);
-        const double in_pass = double(p.tiles_done) - double(p.pass) * tiles_per_pass;
-        progress.update(double(p.samples_done) + double(passes[size_t(p.pass)]) * in_pass / tiles_per_pass,
-                        double(settings.spp));
-      },
+      [&](const RenderProgress& p) { progress.update(p.done_fraction * double(settings.spp), double(settings.spp)); },
       &stats);
   progress.finish();
   return film;
@@ -128,10 +124,16 @@ int run_render(const RenderOptions& options) {
     LoadResult loaded = load_render_scene(options, times);
     const Scene& scene = *loaded.scene;
     const RenderSettings settings = render_settings(options, scene, !aovs->empty());
+    if (!options.strategy_images.empty() && scene.integrator.type != IntegratorType::Bdpt)
+      throw UsageError("--strategy-images: the scene is not rendered by bdpt (use --integrator bdpt)");
     RenderStats stats;
     const Film film = render_with_progress(scene, settings, options.quiet, stats);
     write_outputs(options, scene, film, stats.spp_done, *aovs);
     print_render_report(options, scene, settings, stats, film, times);
+    if (!options.strategy_images.empty()) {
+      const int n = write_strategy_images(*loaded.scene, settings, options.strategy_images);
+      if (!options.quiet) std::cerr << "strategy images: " << n << " in " << options.strategy_images << "\n";
+    }
     return 0;
   } catch (const UsageError& e) {
     std::cerr << "tessera render: " << e.what() << "\n";
@@ -181,6 +183,9 @@ Command add_render_command(CLI::App& app) {
   r->add_option("--light-selection", o->light_selection,
                 "How next-event estimation picks a light: power (alias table) or bvh (light hierarchy; default)")
       ->check(CLI::IsMember({"power", "bvh"}));
+  r->add_option("--strategy-images", o->strategy_images,
+                "bdpt: also write DIR/sS_tT.exr, what each strategy (s light and t camera vertices) adds with "
+                "its MIS weight, for paths up to the max depth (5 when unbounded); they sum to the image");
   r->add_flag("--allow-unsupported", o->allow_unsupported, "Substitute documented fallbacks for unsupported plugins/parameters");
   r->add_flag("-q,--quiet", o->quiet, "No progress output");
   return {r, [o, defines] { return parse_defines(*defines, o->defines, "tessera render") ? run_render(*o) : 2; }};

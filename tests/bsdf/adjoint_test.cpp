@@ -99,7 +99,9 @@ TEST(BsdfAdjoint, ADeltaRefractionUndoesTheRadianceScaling) {
     const bool refracted = bs.wi.z < 0.f;
     const float fresnel_part = refracted ? bs.weight.g * bs.eta * bs.eta : bs.weight.g;
     EXPECT_NEAR(w.g, fresnel_part, 1e-5f);
-    if (refracted) EXPECT_NEAR(w.g, 1.f, 1e-4f) << "weight (1 - F) / (1 - F), energy kept";
+    if (refracted) {
+      EXPECT_NEAR(w.g, 1.f, 1e-4f) << "weight (1 - F) / (1 - F), energy kept";
+    }
   }
 }
 

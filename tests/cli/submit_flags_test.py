@@ -14,6 +14,7 @@ import sys
 # Render flags that cannot apply to a job, each with the reason.
 RENDER_ONLY = {
     "threads": "a job's units render on the workers, each with its own cores (tessera-worker --threads)",
+    "strategy-images": "a debugging render per strategy, each an image of its own, on this machine",
 }
 
 

@@ -5,6 +5,7 @@
 // wrong throughput, density or importance shows here on its own, where under MIS it would be
 // diluted by the others.
 #include "independent_renders.h"
+#include "tessera/render/bdpt.h"
 #include "tessera/scene/load_context.h"
 #include "tessera/scene/scene_desc.h"
 
@@ -86,6 +87,36 @@ TEST(BdptStrategy, EachStrategyAloneRendersItsPathLength) {
                    "strategy (" + std::to_string(s) + ", " + std::to_string(t) + ")", 0.01);
     }
   }
+}
+
+// Each strategy with its MIS weight (only_weighted, what `tessera render --strategy-images`
+// writes): over every strategy bdpt has for paths up to the max depth, the images add up to the
+// full render, pixel by pixel (up to float rounding: the full render sums a sample's strategies
+// before the pixel's samples).
+TEST(BdptStrategy, WeightedStrategiesSumToTheImage) {
+  auto scene = box("bdpt", 3);
+  const RenderSettings settings = render_settings(8, 5);
+  const Image full = render(*scene, settings).to_image();
+  Image sum(full.width(), full.height(), 3);
+  const auto strategies = bdpt_strategies(3);
+  EXPECT_EQ(strategies.size(), 8u) << "(0,2) (0,3) (1,2) (2,1) (0,4) (1,3) (2,2) (3,1)";
+  for (const auto& [s, t] : strategies) {
+    scene->integrator.only_s = s;
+    scene->integrator.only_t = t;
+    scene->integrator.only_weighted = true;
+    const Image part = render(*scene, settings).to_image();
+    for (int y = 0; y < full.height(); ++y)
+      for (int x = 0; x < full.width(); ++x)
+        for (int c = 0; c < 3; ++c) sum.at(x, y, c) += part.at(x, y, c);
+  }
+  double lit = 0;
+  for (int y = 0; y < full.height(); ++y)
+    for (int x = 0; x < full.width(); ++x)
+      for (int c = 0; c < 3; ++c) {
+        ASSERT_NEAR(sum.at(x, y, c), full.at(x, y, c), 1e-4f * full.at(x, y, c) + 1e-6f) << x << "," << y;
+        lit += full.at(x, y, c);
+      }
+  EXPECT_GT(lit, 1.0);
 }
 
 }  // namespace

@@ -251,6 +251,14 @@ bool traces_light_paths(const IntegratorSettings& s) {
   return s.type == IntegratorType::Ptracer || (s.type == IntegratorType::Bdpt && s.light_image);
 }
 
+std::vector<std::pair<int, int>> bdpt_strategies(int max_length) {
+  std::vector<std::pair<int, int>> out;
+  for (int length = 1; length <= max_length; ++length)
+    for (int s = 0; s <= length; ++s)
+      if (const int t = length + 1 - s; t >= 2 || s >= 2) out.emplace_back(s, t);  // ((0, 1), (1, 1): none)
+  return out;
+}
+
 std::unique_ptr<Integrator> make_bdpt_integrator(const IntegratorSettings& settings) {
   return std::make_unique<BdptIntegrator>(settings);
 }

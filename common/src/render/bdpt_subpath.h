@@ -20,10 +20,12 @@ namespace tessera::bdpt {
 inline float mis(float x) { return x * x; }
 
 /// The weight of strategy (s, t) (s light vertices, t camera vertices): its MIS weight, or with
-/// IntegratorSettings::only_s set, 1 for that one strategy and 0 for every other.
+/// IntegratorSettings::only_s set, 0 for every other strategy and for that one 1 (or its MIS
+/// weight, only_weighted).
 inline float strategy_weight(const IntegratorSettings& settings, int s, int t, float mis_weight) {
   if (settings.only_s < 0) return mis_weight;
-  return s == settings.only_s && t == settings.only_t ? 1.f : 0.f;
+  if (s != settings.only_s || t != settings.only_t) return 0.f;
+  return settings.only_weighted ? mis_weight : 1.f;
 }
 
 struct Vertex {

@@ -72,7 +72,7 @@ void connect_to_camera(const Scene& scene, const bdpt::Vertex& v, float time, bo
   const Rgb f = adjoint_eval(v.si, *v.bsdf, v.wo_world, cs.wi);
   if (f.is_black() || cs.we.is_black()) return;
   float w = 1.f;
-  if (weighted && scene.integrator.only_s < 0) {
+  if (weighted && (scene.integrator.only_s < 0 || scene.integrator.only_weighted)) {
     Ray from_camera{cs.p_lens, -cs.wi};
     from_camera.time = time;
     float pdf_pos = 0.f, pdf_dir = 0.f;

@@ -6,6 +6,7 @@
 #include "tessera/sequence/local_driver.h"
 #include "tessera/sequence/path_program.h"
 
+#include <algorithm>
 #include <chrono>
 #include <stdexcept>
 #include <string>
@@ -75,6 +76,7 @@ Film render(const Scene& scene, const RenderSettings& settings, const ProgressCa
     prog.pass = int(pass);
     prog.tiles_done = int64_t(s.done_units());
     prog.samples_done = s.spp_complete();
+    prog.done_fraction = double(s.done_samples()) / double(std::max<uint64_t>(1, s.planned_samples()));
     if (progress) progress(prog);
   });
   FilmAssembler& films = sequencer.films();

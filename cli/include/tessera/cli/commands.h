@@ -28,6 +28,7 @@ struct RenderOptions {
   bool denoise = false;                    // outputs get the denoised image, FILE.noisy.ext the raw one
   std::string denoise_mode = "full";       // "full" or "preview"
   bool allow_unsupported = false;
+  std::string strategy_images;             // bdpt: a directory for one image per strategy (bdpt.h)
   bool quiet = false;
 };
 

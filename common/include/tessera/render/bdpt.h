@@ -33,6 +33,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <utility>
 #include <vector>
 
 namespace tessera {
@@ -72,6 +73,9 @@ class LightSplats {
 /// first = sample_begin * window pixels), each connected to the camera (t = 1) with its MIS
 /// weight (bdpt) or alone (ptracer), into `out` (reset by the caller).
 void trace_light_paths(const Scene& scene, uint64_t path_begin, uint64_t path_end, uint32_t seed, LightSplats& out);
+
+/// The strategies (s, t) bdpt has for paths of 1 .. max_length segments, by length then s.
+std::vector<std::pair<int, int>> bdpt_strategies(int max_length);
 
 std::unique_ptr<Integrator> make_bdpt_integrator(const IntegratorSettings& settings);
 /// Its li() renders only what the camera sees directly (s = 0 at the first hit).

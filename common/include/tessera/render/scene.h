@@ -46,8 +46,10 @@ struct IntegratorSettings {
   bool light_image = true;
   bool sample_direct = true;
   // bdpt, for tests and debugging (never read from files): only strategy (s, t) (bdpt.h), with
-  // weight 1; every other strategy adds nothing. s = -1: all of them, MIS-weighted.
+  // weight 1 or, with only_weighted, its MIS weight (the images of every strategy then sum to
+  // the render's); every other strategy adds nothing. s = -1: all of them, MIS-weighted.
   int only_s = -1, only_t = -1;
+  bool only_weighted = false;
   // How next-event estimation picks a light (render/light_sampler.h); read by Scene::finalize.
   LightSelection light_selection = LightSelection::Bvh;
   SamplingStrategy strategy = SamplingStrategy::Mis;  // path/volpath only; not read from scene files

@@ -59,6 +59,9 @@ struct RenderProgress {
   int pass = 0, num_passes = 0;
   int64_t tiles_done = 0, tiles_total = 0;  // over the whole render
   uint32_t samples_done = 0, spp = 0;       // samples per pixel in finished passes
+  /// Of all the render's work: its units' samples done over those planned (light paths count as
+  /// samples), so a progress bar moves as the work does whatever the passes are.
+  double done_fraction = 0;
 };
 /// Called after every finished tile, from worker threads but never concurrently.
 using ProgressCallback = std::function<void(const RenderProgress&)>;
