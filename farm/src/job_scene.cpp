@@ -136,10 +136,7 @@ SplatResult render_paths_lease(const Scene& scene, const Lease& lease) {
   r.unit = lease.tile;
   r.path_begin = lease.paths->first;
   r.path_end = lease.paths->second;
-  thread_local LightSplats splats;
-  splats.reset(film_window(scene.film), scene.film.width, scene.film.height);
-  trace_light_paths(scene, r.path_begin, r.path_end, lease.settings.seed, splats);
-  to_splat_sums(splats, r.splats);
+  render_light_unit(scene, r.path_begin, r.path_end, lease.settings.seed, r.splats);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }

@@ -28,11 +28,7 @@ class PathUnits final : public UnitRenderer {
 
   void render(const PassSequencer& sequencer, const UnitWork& work, UnitResult& result) override {
     if (work.kind == UnitKind::Paths) {
-      thread_local LightSplats splats;
-      const SequenceFrame& f = sequencer.frame();
-      splats.reset(f.window, f.full_width, f.full_height);
-      trace_light_paths(scene_, work.path_begin, work.path_end, seed_, splats);
-      to_splat_sums(splats, result.splats);
+      render_light_unit(scene_, work.path_begin, work.path_end, seed_, result.splats);
       return;
     }
     std::optional<PathGuide> guide;

@@ -54,4 +54,15 @@ inline void to_splat_sums(const LightSplats& in, SplatSums& out) {
   }
 }
 
+/// A light-tracing unit (PassSpec::same_samples) of a scene's light-tracing integrator: light paths
+/// [path_begin, path_end) over the scene's film window, as its result. The one way `tessera
+/// render` and a farm worker render such a unit.
+inline void render_light_unit(const Scene& scene, uint64_t path_begin, uint64_t path_end, uint32_t seed,
+                              SplatSums& out) {
+  thread_local LightSplats splats;  // (its window-sized buffers reused from unit to unit)
+  splats.reset(film_window(scene.film), scene.film.width, scene.film.height);
+  trace_light_paths(scene, path_begin, path_end, seed, splats);
+  to_splat_sums(splats, out);
+}
+
 }  // namespace tessera
