@@ -18,6 +18,8 @@
 #   passes by `--integrator bdpt|ptracer`, keeping the scene's depths)  ET_THREADS=2  ET_OUT=docs/performance
 #   TESSERA=path/to/tessera (default BUILD_DIR/cli/tessera)
 #   ET_TABLE_ONLY=1: render nothing, make the table again from OUT/equal_time.csv
+#   ET_REFERENCES=DIR: for each scene with DIR/NAME/reference.exr and variance.exr (as
+#   bench/bdpt_reference.sh writes them), compare against those instead of ../shared/references/
 # A missing scene or reference is an error (exit 1), never a skip.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -49,6 +51,11 @@ for s in ${scenes[@]+"${scenes[@]}"}; do
   extra=() path=()
   # Its reference was rendered with `path`; its sky is seen through window glass (docs/performance.md).
   [ "$s" = kitchenette ] && extra=(--allow-unsupported) path=(--integrator path)
+  ref=$shared/references/$s
+  if [ -n "${ET_REFERENCES:-}" ] && [ -f "$ET_REFERENCES/$s/reference.exr" ]; then
+    ref=$ET_REFERENCES/$s
+    [ -f "$ref/variance.exr" ] || { echo "equal_time.sh: missing $ref/variance.exr" >&2; exit 1; }
+  fi
   for seed in "${seeds[@]}"; do
     for c in "${configs[@]}"; do
       guiding=off adaptive=off integrator=("${path[@]}")
@@ -62,8 +69,7 @@ for s in ${scenes[@]+"${scenes[@]}"}; do
         --seed "$seed" --threads "$threads" --guiding "$guiding" --adaptive "$adaptive" -q -o "$tmp/img.exr" \
         2> "$tmp/log"
       secs=$(grep -o 'render [0-9.e+-]* s' "$tmp/log" | tail -1 | awk '{print $2}')
-      cmp=$("$tessera" compare "$tmp/img.exr" "$shared/references/$s/reference.exr" \
-        --variance "$shared/references/$s/variance.exr")
+      cmp=$("$tessera" compare "$tmp/img.exr" "$ref/reference.exr" --variance "$ref/variance.exr")
       field() { echo "$cmp" | grep -o " $1=[^ ]*" | cut -d= -f2; }
       echo "$s,$c,$seed,$spp,$secs,$(field rel_mse),$(field rel_mse_trim),$(field ref_floor)" | tee -a "$csv" >&2
     done

@@ -118,6 +118,9 @@ void print_render_report(const RenderOptions& options, const Scene& scene, const
   if (stats.guide_leaves > 0)
     std::fprintf(stderr, "guide: %zu spatial leaves, %.1f MB (cap %.0f MB)\n", stats.guide_leaves,
                  double(stats.guide_bytes) / 1e6, double(guide_plan(scene, settings.guiding)->settings.max_bytes) / 1e6);
+  if (const EmissionPortal& portal = scene.emission_portal(); portal.active())
+    std::fprintf(stderr, "emission portal: %d boxes from %u escapes of %u pilot camera paths\n", portal.box_count(),
+                 portal.escapes(), EmissionPortal::kPilotPaths);
   if (settings.target_error > 0)
     std::fprintf(stderr, "target error %g: %s at %u spp, estimated relMSE %.4g\n", settings.target_error,
                  stats.spp_done < uint32_t(settings.spp) ? "stopped" : "not reached, budget spent", stats.spp_done,

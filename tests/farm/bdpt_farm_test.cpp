@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <filesystem>
 #include <thread>
 
 namespace tessera::test {
@@ -36,6 +37,28 @@ TEST(BdptFarm, TwoWorkersGiveTheLocalImage) {
     ASSERT_EQ(st.value("state", ""), "done") << st.dump();
     EXPECT_EQ(differing_pixels(farm.image(id), local_render(cornell(), s)), 0) << integrator;
   }
+}
+
+// A distant light's light subpaths start through the emission portal that each worker finds for
+// itself (render/emission_portal.h): the same boxes everywhere, so the same bits.
+TEST(BdptFarm, AnEnvironmentThroughAnEmissionPortalGivesTheLocalImage) {
+  const std::string scene = shared_path("scenes/living-room/scene.xml");
+  TESSERA_REQUIRE_FILE(scene);
+  const JobSettings s = bdpt_settings("bdpt");
+  {
+    const auto abs = std::filesystem::absolute(scene);
+    const LoadedJobScene local = load_job_scene(abs.parent_path().string(), abs.filename().string(), s, false);
+    ASSERT_GT(local.loaded.scene->emission_portal().box_count(), 0) << "the scene's env light starts through a portal";
+  }
+  Farm farm;
+  farm.start_server();
+  farm.add_worker(1);
+  farm.add_worker(1);
+  const uint64_t id = farm.submit(scene, s);
+  ASSERT_GT(id, 0u);
+  const nlohmann::json st = farm.wait_job(id, 200);
+  ASSERT_EQ(st.value("state", ""), "done") << st.dump();
+  EXPECT_EQ(differing_pixels(farm.image(id), local_render(scene, s)), 0);
 }
 
 TEST(BdptFarm, KilledWorkerAndRestartedCoordinatorKeepTheBits) {

@@ -49,6 +49,7 @@ class DirectionalLight final : public Light {
   }
 
   bool is_delta() const override { return true; }
+  bool is_distant() const override { return true; }
   float power() const override {
     const float r = radius_ > 0.f ? radius_ : 1.f;
     return kPi * r * r * irradiance_.luminance();

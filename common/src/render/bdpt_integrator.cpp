@@ -108,6 +108,7 @@ class BdptIntegrator final : public Integrator {
       const float direct_w = s_.sample_direct ? scene.light_pmf(c.prev_ctx, env) * env->pdf_env(d) : 0.f;
       float pdf_pos = 0.f, pdf_dir = 0.f;
       env->pdf_le(Vec3(0.f), Vec3(0.f), -d, pdf_pos, pdf_dir);
+      pdf_pos = bdpt::distant_pdf_pos(scene, c.prev_ctx.p, -d, pdf_pos);
       const float emission_pdf = scene.light_sampler().emitter_pmf(env) * pdf_pos * pdf_dir;
       sum += le * bdpt::strategy_weight(s_, 0, c.length + 1, 1.f / (1.f + mis(direct_w) * c.d_vcm + mis(emission_pdf) * c.d_vc));
     }
@@ -134,6 +135,7 @@ class BdptIntegrator final : public Integrator {
     const float cos_at_light = on_surface ? std::abs(dot(ls.n_light, ls.wi)) : 1.f;
     float pdf_pos = 0.f, pdf_dir = 0.f;
     light->pdf_le(ls.p_light, ls.n_light, -ls.wi, pdf_pos, pdf_dir);
+    if (light->is_distant()) pdf_pos = bdpt::distant_pdf_pos(scene, si.p, -ls.wi, pdf_pos);
     const float emission_w = scene.light_sampler().emitter_pmf(light) * pdf_pos * pdf_dir;
     const float pdf_fwd = ls.delta ? 0.f : v.bsdf->pdf(si, v.wo, wi);
     const float pdf_rev = v.bsdf->pdf(si, wi, v.wo);

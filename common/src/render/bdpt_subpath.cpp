@@ -24,7 +24,10 @@ bool start_light_subpath(const Scene& scene, Sampler& sampler, LightOrigin& o, R
   float pmf = 0.f;
   o.light = scene.light_sampler().sample_emitter(u_pick, pmf);
   if (!o.light || !(pmf > 0.f) || !o.light->sample_le(u_pos, u_dir, o.emission)) return false;
-  const LightEmission& e = o.emission;
+  LightEmission& e = o.emission;
+  // A distant light's ray starts where the scene's emission portal puts it (emission_portal.h).
+  if (const EmissionPortal& portal = scene.emission_portal(); e.infinite && portal.active())
+    if (!portal.sample(e.dir, u_pos, e.p, e.pdf_pos)) return false;
   o.emission_pdf = pmf * e.pdf_pos * e.pdf_dir;
   o.delta = e.delta_pos || e.delta_dir;
   const float cos_light = (e.infinite || e.delta_pos) ? 1.f : std::abs(dot(e.n, e.dir));

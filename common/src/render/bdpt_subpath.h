@@ -64,6 +64,14 @@ void trace_light_subpath(const Scene& scene, const IntegratorSettings& settings,
 /// selection pmf alone for a delta position or direction.
 float direct_pdf(const Scene& scene, const SurfaceInteraction& si, const LightOrigin& origin);
 
+/// The density per unit area perpendicular to `dir` with which a distant light's subpath starts
+/// on the line through `p` along `dir` (the direction of travel): the scene's emission portal's,
+/// or without one the light's own disk's, `disk_pdf` (what its pdf_le gave).
+inline float distant_pdf_pos(const Scene& scene, Vec3 p, Vec3 dir, float disk_pdf) {
+  const EmissionPortal& portal = scene.emission_portal();
+  return portal.active() ? portal.pdf(p, dir) : disk_pdf;
+}
+
 /// The scene's time for a pixel sample (motion blur), as render_tile gives it to the camera ray.
 float sample_time(const Scene& scene, Sampler& sampler);
 

@@ -100,6 +100,8 @@ class Light {
   }
 
   virtual bool is_infinite() const { return false; }
+  /// Emits from far away along parallel rays (sample_le's disk): infinite lights and directional.
+  virtual bool is_distant() const { return is_infinite(); }
   virtual bool is_delta() const { return false; }
   /// Total emitted power (an estimate is fine); lights are picked in proportion to it.
   virtual float power() const = 0;

@@ -10,6 +10,7 @@
 #include "tessera/render/light_sampler.h"
 #include "tessera/render/bsdf.h"
 #include "tessera/render/camera.h"
+#include "tessera/render/emission_portal.h"
 #include "tessera/render/light.h"
 #include "tessera/render/medium.h"
 #include "tessera/render/instance.h"
@@ -137,6 +138,9 @@ class Scene {
   }
   const LightSampler& light_sampler() const { return light_sampler_; }
   const std::vector<const Light*>& infinite_lights() const { return infinite_lights_; }
+  /// Where distant lights' light subpaths start (render/emission_portal.h): found by finalize()
+  /// for the bidirectional integrators when the scene has a distant light, else empty.
+  const EmissionPortal& emission_portal() const { return emission_portal_; }
 
   const Bvh& accel() const { return accel_; }
   Bounds3 bounds() const { return merge(accel_.bounds(), top_.bounds()); }
@@ -155,6 +159,7 @@ class Scene {
   std::vector<uint32_t> shape_first_;  // shape index -> first primitive in its BVH (world or group)
   LightSampler light_sampler_;
   std::vector<const Light*> infinite_lights_;
+  EmissionPortal emission_portal_;
   size_t num_triangles_ = 0;
   double bvh_seconds_ = 0;
   bool has_masks_ = false;
