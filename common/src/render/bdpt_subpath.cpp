@@ -80,11 +80,6 @@ float direct_pdf(const Scene& scene, const SurfaceInteraction& si, const LightOr
   return std::isfinite(pdf) ? pdf : 0.f;
 }
 
-float sample_time(const Scene& scene, Sampler& sampler) {
-  if (!scene.has_shutter_interval()) return scene.shutter_open;
-  return scene.shutter_open + (scene.shutter_close - scene.shutter_open) * sampler.sample_1d_at(Sampler::kTimeDimension);
-}
-
 void trace_light_subpath(const Scene& scene, const IntegratorSettings& s, Sampler& sampler, float time,
                          LightSubpath& out, RenderCounters& counters) {
   out.vertices.clear();

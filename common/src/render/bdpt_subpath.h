@@ -72,7 +72,5 @@ inline float distant_pdf_pos(const Scene& scene, Vec3 p, Vec3 dir, float disk_pd
   return portal.active() ? portal.pdf(p, dir) : disk_pdf;
 }
 
-/// The scene's time for a pixel sample (motion blur), as render_tile gives it to the camera ray.
-float sample_time(const Scene& scene, Sampler& sampler);
 
 }  // namespace tessera::bdpt

@@ -3,6 +3,7 @@
 #include "render/bdpt_subpath.h"
 
 #include "tessera/core/check.h"
+#include "tessera/render/render_tile.h"
 
 #include <algorithm>
 #include <cmath>
@@ -104,7 +105,7 @@ void trace_light_paths(const Scene& scene, uint64_t path_begin, uint64_t path_en
     const uint64_t i = k % pixels;
     const Vec2i pixel{window.x0 + int(i % uint64_t(window.width())), window.y0 + int(i / uint64_t(window.width()))};
     sampler.start_pixel_sample(pixel, uint32_t(k / pixels));
-    const float time = bdpt::sample_time(scene, sampler);
+    const float time = camera_sample_time(scene, sampler);
     ++out.counters.samples;
     if (s.max_depth == 0) continue;
     bdpt::trace_light_subpath(scene, s, sampler, time, light, out.counters);

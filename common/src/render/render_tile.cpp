@@ -5,6 +5,11 @@
 
 namespace tessera {
 
+float camera_sample_time(const Scene& scene, Sampler& sampler) {
+  if (!scene.has_shutter_interval()) return scene.shutter_open;
+  return scene.shutter_open + (scene.shutter_close - scene.shutter_open) * sampler.sample_1d_at(Sampler::kTimeDimension);
+}
+
 void render_tile(const Scene& scene, const Integrator& integrator, const TileRect& rect, const PassSamples& samples,
                  uint32_t seed, FilmTile& tile, const PathGuide* guide, bool aovs) {
   TESSERA_CHECK(samples.rect.contains(rect));
@@ -12,8 +17,6 @@ void render_tile(const Scene& scene, const Integrator& integrator, const TileRec
   TESSERA_CHECK(scene.camera != nullptr);
   tile.reset(rect, aovs);
   Sampler sampler(scene.sampler.type, seed);
-  const bool timed = scene.has_shutter_interval();
-  const float open = scene.shutter_open, shutter = scene.shutter_close - scene.shutter_open;
   for (int y = rect.y0; y < rect.y1; ++y) {
     for (int x = rect.x0; x < rect.x1; ++x) {
       const size_t i = samples.index({x, y});
@@ -27,8 +30,7 @@ void render_tile(const Scene& scene, const Integrator& integrator, const TileRec
         Vec2 raster(float(x) + 0.5f + offset.x, float(y) + 0.5f + offset.y);
         // Motion blur: a time in the shutter from a dedicated dimension (sampler.h); without it,
         // the layout and every value are the same as before.
-        const float time = timed ? open + shutter * sampler.sample_1d_at(Sampler::kTimeDimension) : open;
-        Ray ray = scene.camera->generate_ray_at(raster, u_lens, time);
+        Ray ray = scene.camera->generate_ray_at(raster, u_lens, camera_sample_time(scene, sampler));
         ++tile.counters.camera_rays;
         if (tile.has_aovs()) {
           SampleFeatures features;

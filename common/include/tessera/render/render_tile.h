@@ -18,8 +18,15 @@
 
 namespace tessera {
 
+class Sampler;
+
 /// Renders samples [sample_begin, sample_end) of every pixel of `rect` into `tile`, which is reset
 /// to `rect` first.
+/// The scene's time for the pixel sample the sampler is at (motion blur: uniform over the shutter
+/// from Sampler::kTimeDimension; without a shutter interval, shutter_open). Light subpaths use
+/// the camera ray's time.
+float camera_sample_time(const Scene& scene, Sampler& sampler);
+
 void render_tile(const Scene& scene, const TileRect& rect, uint32_t sample_begin, uint32_t sample_end,
                  uint32_t seed, FilmTile& tile);
 
