@@ -100,14 +100,14 @@ int grid_cell(const Bounds3& bounds, Vec3 p) {
 }  // namespace
 
 void EmissionPortal::add_box(const Bounds3& b) {
-  if (count_ < kMaxBoxes && !b.empty()) boxes_[size_t(count_++)] = b;
+  if (count_ >= kMaxBoxes || b.empty()) return;
+  boxes_[size_t(count_++)] = b;
+  const Vec3 e = b.diagonal();
+  for (int k = 0; k < 3; ++k) face_area_sum_[size_t(k)] += e[(k + 1) % 3] * e[(k + 2) % 3];
 }
 
 float EmissionPortal::projected_area(Vec3 dir) const {
-  float total = 0.f;
-  for (int i = 0; i < count_; ++i)
-    for (int k = 0; k < 3; ++k) total += face_area(boxes_[size_t(i)], k, dir);
-  return total;
+  return std::abs(dir.x) * face_area_sum_[0] + std::abs(dir.y) * face_area_sum_[1] + std::abs(dir.z) * face_area_sum_[2];
 }
 
 Vec3 EmissionPortal::box_point(Vec3 dir, Vec2 u) const {

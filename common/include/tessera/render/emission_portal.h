@@ -69,6 +69,9 @@ class EmissionPortal {
   Vec3 box_point(Vec3 dir, Vec2 u) const;
   std::array<Bounds3, kMaxBoxes> boxes_{};
   int count_ = 0;
+  // Per axis k, the boxes' face areas perpendicular to it: the projected area along dir is
+  // sum_k |dir_k| face_area_sum_[k].
+  std::array<float, 3> face_area_sum_{};
   uint32_t escapes_ = 0;
   Vec3 center_;
   float radius_ = 0.f;
