@@ -15,7 +15,7 @@
 # reference's from its per-pixel variance (Mitsuba's path tracer: independent pixels).
 #
 # Usage: bench/bdpt_reference.sh [BUILD_DIR] [SCENE] [RENDERS] [SPP] [OUT]
-#        (defaults: build kitchenette 16 256 bench-out/references)
+#        (defaults: build kitchenette 16 256 out/references)
 # Environment: BR_THREADS=2  BR_BUDGET=60  BR_BUDGET_RENDERS=8  TESSERA=path/to/tessera
 #   BR_SKIP_REFERENCE=1: reuse OUT/SCENE/reference.exr and runs.csv, run step 2 only.
 # Needs oiiotool (OpenImageIO's tools). A missing scene or reference is an error, never a skip.
@@ -25,7 +25,7 @@ build=${1:-build}
 scene=${2:-kitchenette}
 renders=${3:-16}
 spp=${4:-256}
-out=${5:-bench-out/references}
+out=${5:-out/references}
 tessera=${TESSERA:-$build/cli/tessera}
 threads=${BR_THREADS:-2}
 budget=${BR_BUDGET:-60}
