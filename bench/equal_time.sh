@@ -10,6 +10,8 @@
 # and, the same way, the time each configuration needs to bring the error above the floor down to
 # 0.05 and 0.01 (against the floor, since kitchenette's and veach-bidir's floors are above 0.01):
 #   time to X = (relMSE - floor) * seconds / X
+# and the relMSE without the worst 0.1% of pixels at plain's time, scaled the same way (plain's own
+# unscaled: a path tracer's firefly-ridden error there need not fall as 1/time).
 # Writes OUT/equal_time.csv (every run) and OUT/equal_time.md (the table), and prints the table.
 #
 # Usage: bench/equal_time.sh [BUILD_DIR] [SPP]      (defaults: build, 128)
@@ -18,6 +20,8 @@
 #   passes by `--integrator bdpt|ptracer`, keeping the scene's depths)  ET_THREADS=2  ET_OUT=docs/performance
 #   TESSERA=path/to/tessera (default BUILD_DIR/cli/tessera)
 #   ET_TABLE_ONLY=1: render nothing, make the table again from OUT/equal_time.csv
+#   ET_CONFIG_SPP="bdpt=222 ...": those configurations' spp instead of SPP (to render them in
+#   about plain's time, for the last column)
 #   ET_REFERENCES=DIR: for each scene with DIR/NAME/reference.exr and variance.exr (as
 #   bench/bdpt_reference.sh writes them), compare against those instead of ../shared/references/
 # A missing scene or reference is an error (exit 1), never a skip.
@@ -64,14 +68,16 @@ for s in ${scenes[@]+"${scenes[@]}"}; do
         bdpt|ptracer) integrator=(--integrator "$c") ;;
         *) echo "equal_time.sh: unknown configuration '$c'" >&2; exit 1 ;;
       esac
+      config_spp=$spp
+      for o in ${ET_CONFIG_SPP:-}; do [ "${o%%=*}" = "$c" ] && config_spp=${o#*=}; done
       "$tessera" render "$shared/scenes/$s/scene.xml" ${extra[@]+"${extra[@]}"} ${integrator[@]+"${integrator[@]}"} \
-        --width "$w" --height "$h" --spp "$spp" \
+        --width "$w" --height "$h" --spp "$config_spp" \
         --seed "$seed" --threads "$threads" --guiding "$guiding" --adaptive "$adaptive" -q -o "$tmp/img.exr" \
         2> "$tmp/log"
       secs=$(grep -o 'render [0-9.e+-]* s' "$tmp/log" | tail -1 | awk '{print $2}')
       cmp=$("$tessera" compare "$tmp/img.exr" "$ref/reference.exr" --variance "$ref/variance.exr")
       field() { echo "$cmp" | grep -o " $1=[^ ]*" | cut -d= -f2; }
-      echo "$s,$c,$seed,$spp,$secs,$(field rel_mse),$(field rel_mse_trim),$(field ref_floor)" | tee -a "$csv" >&2
+      echo "$s,$c,$seed,$config_spp,$secs,$(field rel_mse),$(field rel_mse_trim),$(field ref_floor)" | tee -a "$csv" >&2
     done
   done
 done
@@ -83,9 +89,10 @@ med = lambda xs: statistics.median(xs)
 runs = {}
 for r in rows:
     runs.setdefault((r["scene"], r["config"]), []).append(r)
-lines = ["| scene | configuration | seconds | relMSE | relMSE, worst 0.1% left out | reference floor | "
-         "relMSE at plain's time | against plain | seconds to 0.05 above floor | seconds to 0.01 above floor |",
-         "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+lines = ["| scene | configuration | spp | seconds | relMSE | relMSE, worst 0.1% left out | reference floor | "
+         "relMSE at plain's time | against plain | seconds to 0.05 above floor | seconds to 0.01 above floor | "
+         "worst 0.1% left out, at plain's time |",
+         "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
 def time_to(rs, floor, target):
     return "%.3g" % med([(float(r["rel_mse"]) - floor) * float(r["seconds"]) / target for r in rs])
 for scene in dict.fromkeys(r["scene"] for r in rows):
@@ -99,12 +106,16 @@ for scene in dict.fromkeys(r["scene"] for r in rows):
         floor = float(rs[0]["ref_floor"])
         # Per seed, then the median: each seed's error scaled to plain's median time.
         eq = med([floor + (float(r["rel_mse"]) - floor) * float(r["seconds"]) / t_plain for r in rs]) if t_plain else None
+        eq_trim = med([floor + (float(r["rel_mse_trim"]) - floor) * float(r["seconds"]) / t_plain for r in rs]) if t_plain else None
         if config == "plain":
             e_plain = eq
-        ratio = "%.2f" % (eq / e_plain) if eq is not None and e_plain else ""
-        lines.append("| %s | %s | %.2f | %.4g | %.4g | %.2g | %s | %s | %s | %s |" % (
-            scene, config, t, med([float(r["rel_mse"]) for r in rs]), med([float(r["rel_mse_trim"]) for r in rs]),
-            floor, "%.4g" % eq if eq is not None else "", ratio, time_to(rs, floor, 0.05), time_to(rs, floor, 0.01)))
+        ratio = "%.3g" % (eq / e_plain) if eq is not None and e_plain else ""
+        if config == "plain":
+            eq_trim = med([float(r["rel_mse_trim"]) for r in rs])  # its own, not scaled: it need not fall as 1/time
+        lines.append("| %s | %s | %s | %.2f | %.4g | %.4g | %.2g | %s | %s | %s | %s | %s |" % (
+            scene, config, rs[0]["spp"], t, med([float(r["rel_mse"]) for r in rs]), med([float(r["rel_mse_trim"]) for r in rs]),
+            floor, "%.4g" % eq if eq is not None else "", ratio, time_to(rs, floor, 0.05), time_to(rs, floor, 0.01),
+            "%.4g" % eq_trim if eq_trim is not None else ""))
 open(sys.argv[2], "w").write("\n".join(lines) + "\n")
 print("\n".join(lines))
 PY
