@@ -89,7 +89,7 @@ class BdptIntegrator final : public Integrator {
       direct_a = scene.light_pmf(c.prev_ctx, &area) * area.pdf_li(c.prev_ctx.p, si) * cos_light / (dist * dist);
     }
     float pdf_pos = 0.f, pdf_dir = 0.f;
-    area.pdf_le(si.p, si.ng, wo_world, pdf_pos, pdf_dir);
+    bdpt::emission_pdfs(scene, area, si.p, si.ng, wo_world, si.p, pdf_pos, pdf_dir);
     const float emission_pdf = scene.light_sampler().emitter_pmf(&area) * pdf_pos * pdf_dir;
     const float w = mis(direct_a) * c.d_vcm + mis(emission_pdf) * c.d_vc;
     return le * bdpt::strategy_weight(s_, 0, c.length + 1, 1.f / (1.f + w));
@@ -107,8 +107,7 @@ class BdptIntegrator final : public Integrator {
       }
       const float direct_w = s_.sample_direct ? scene.light_pmf(c.prev_ctx, env) * env->pdf_env(d) : 0.f;
       float pdf_pos = 0.f, pdf_dir = 0.f;
-      env->pdf_le(Vec3(0.f), Vec3(0.f), -d, pdf_pos, pdf_dir);
-      pdf_pos = bdpt::distant_pdf_pos(scene, c.prev_ctx.p, -d, pdf_pos);
+      bdpt::emission_pdfs(scene, *env, Vec3(0.f), Vec3(0.f), -d, c.prev_ctx.p, pdf_pos, pdf_dir);
       const float emission_pdf = scene.light_sampler().emitter_pmf(env) * pdf_pos * pdf_dir;
       sum += le * bdpt::strategy_weight(s_, 0, c.length + 1, 1.f / (1.f + mis(direct_w) * c.d_vcm + mis(emission_pdf) * c.d_vc));
     }
@@ -134,8 +133,7 @@ class BdptIntegrator final : public Integrator {
     const bool on_surface = length_squared(ls.n_light) > 0.f;
     const float cos_at_light = on_surface ? std::abs(dot(ls.n_light, ls.wi)) : 1.f;
     float pdf_pos = 0.f, pdf_dir = 0.f;
-    light->pdf_le(ls.p_light, ls.n_light, -ls.wi, pdf_pos, pdf_dir);
-    if (light->is_distant()) pdf_pos = bdpt::distant_pdf_pos(scene, si.p, -ls.wi, pdf_pos);
+    bdpt::emission_pdfs(scene, *light, ls.p_light, ls.n_light, -ls.wi, si.p, pdf_pos, pdf_dir);
     const float emission_w = scene.light_sampler().emitter_pmf(light) * pdf_pos * pdf_dir;
     const float pdf_fwd = ls.delta ? 0.f : v.bsdf->pdf(si, v.wo, wi);
     const float pdf_rev = v.bsdf->pdf(si, wi, v.wo);
@@ -246,8 +244,6 @@ class DirectlyVisibleEmitters final : public Integrator {
 };
 
 }  // namespace
-
-bool is_bidirectional(IntegratorType type) { return type == IntegratorType::Bdpt || type == IntegratorType::Ptracer; }
 
 bool traces_light_paths(const IntegratorSettings& s) {
   return s.type == IntegratorType::Ptracer || (s.type == IntegratorType::Bdpt && s.light_image);

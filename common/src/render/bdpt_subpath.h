@@ -64,13 +64,14 @@ void trace_light_subpath(const Scene& scene, const IntegratorSettings& settings,
 /// selection pmf alone for a delta position or direction.
 float direct_pdf(const Scene& scene, const SurfaceInteraction& si, const LightOrigin& origin);
 
-/// The density per unit area perpendicular to `dir` with which a distant light's subpath starts
-/// on the line through `p` along `dir` (the direction of travel): the scene's emission portal's,
-/// or without one the light's own disk's, `disk_pdf` (what its pdf_le gave).
-inline float distant_pdf_pos(const Scene& scene, Vec3 p, Vec3 dir, float disk_pdf) {
-  const EmissionPortal& portal = scene.emission_portal();
-  return portal.active() ? portal.pdf(p, dir) : disk_pdf;
+/// Light::pdf_le as light subpaths start: for a distant light, pdf_pos is the scene's emission
+/// portal's density of the line through `on_line` along `dir` (the direction of travel) when the
+/// scene has a portal, else its own disk's.
+inline void emission_pdfs(const Scene& scene, const Light& light, Vec3 p, Vec3 n, Vec3 dir, Vec3 on_line,
+                          float& pdf_pos, float& pdf_dir) {
+  light.pdf_le(p, n, dir, pdf_pos, pdf_dir);
+  if (const EmissionPortal& portal = scene.emission_portal(); light.is_distant() && portal.active())
+    pdf_pos = portal.pdf(on_line, dir);
 }
-
 
 }  // namespace tessera::bdpt

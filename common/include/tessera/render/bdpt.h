@@ -40,8 +40,6 @@ namespace tessera {
 
 /// True for integrators whose renders have light-tracing units (Paths passes).
 bool traces_light_paths(const IntegratorSettings& settings);
-/// True for bdpt and ptracer.
-bool is_bidirectional(IntegratorType type);
 
 /// What a range of light paths added to the film's window: dense sums over the window and the
 /// pixels touched, in the order they were first touched (so converting to a sparse list is

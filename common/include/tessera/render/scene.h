@@ -29,6 +29,8 @@ namespace tessera {
 // Bdpt and Ptracer (bidirectional path tracing, light tracing: bdpt.h) trace surfaces only; a scene
 // with media asked for them is rendered by VolPath with a note.
 enum class IntegratorType { Path, VolPath, Direct, Bdpt, Ptracer };
+/// True for bdpt and ptracer.
+inline bool is_bidirectional(IntegratorType type) { return type == IntegratorType::Bdpt || type == IntegratorType::Ptracer; }
 // How path/volpath estimate direct light (integrator.h states each rule); Direct ignores it.
 enum class SamplingStrategy { Mis, Bsdf, Nee };
 
