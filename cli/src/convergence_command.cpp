@@ -152,7 +152,7 @@ LoadResult load_for_reference(const ConvergenceOptions& options, const Image& re
   const IntegratorType type = loaded.scene->integrator.type;
   if (type != IntegratorType::Path && type != IntegratorType::VolPath)
     std::fprintf(stderr, "note: the scene uses the %s integrator, which has no strategies: all equal\n",
-                 type == IntegratorType::Direct ? "direct" : type == IntegratorType::Bdpt ? "bdpt" : "ptracer");
+                 integrator_name(type));
   return loaded;
 }
 

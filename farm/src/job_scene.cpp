@@ -64,6 +64,7 @@ JobPlan make_job_plan(const std::string& bundle_dir, const std::string& scene_fi
       throw SceneError(FileLoc{scene_file, 0}, "the scene references '" + f + "', which is outside its bundle");
     if (std::find(plan.files.begin(), plan.files.end(), rel) == plan.files.end()) plan.files.push_back(rel);
   }
+  if (uses_light_vertex_passes(s.integrator.type)) throw std::invalid_argument(kFarmRefusesLightVertexPasses);
   PathProgramOptions options = path_options(plan);
   options.light_paths = traces_light_paths(s.integrator);
   if (is_bidirectional(s.integrator.type) && settings.sums_aovs())

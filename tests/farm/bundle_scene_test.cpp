@@ -275,5 +275,21 @@ TEST(JobPlan, GuidingFollowsTheJobElseTheScene) {
   EXPECT_TRUE(plan().guide);
 }
 
+// A scene file whose integrator is sppm is refused at planning, with what to do instead.
+TEST(JobPlan, AnSppmSceneIsRefused) {
+  TempDir t;
+  std::ofstream(t.path / "scene.xml") << R"(<scene version="0.6.0">
+  <integrator type="sppm"><integer name="photonCount" value="1000"/></integrator>
+  <shape type="sphere"/>
+</scene>)";
+  const JobSettings settings;
+  try {
+    (void)make_job_plan(t.path.string(), "scene.xml", settings, load_job_scene(t.path.string(), "scene.xml", settings));
+    ADD_FAILURE() << "planned";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("tessera render --integrator sppm"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace tessera

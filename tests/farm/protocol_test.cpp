@@ -61,6 +61,14 @@ TEST(Protocol, IntegratorNamesTheLoaderKnows) {
   EXPECT_NE(error.find("job settings: integrator 'bpdt' is not path, volpath, direct, bdpt or ptracer"), std::string::npos)
       << error;
   EXPECT_NE(parse_error(json{{"scene", std::string(64, 'a')}, {"integrator", 3}}).find("'integrator'"), std::string::npos);
+  // The loader knows sppm and vcm, the farm does not run them: refused with what to do instead.
+  for (const char* name : {"sppm", "vcm"}) {
+    JobSettings t;
+    std::string e;
+    ASSERT_TRUE(job_settings_from_json(json{{"scene", std::string(64, 'a')}, {"integrator", name}}, t, e)) << e;
+    EXPECT_FALSE(check_job_limits(t, limits, e));
+    EXPECT_NE(e.find("tessera render --integrator sppm"), std::string::npos) << e;
+  }
 }
 
 // A number its field cannot hold is out of range (the API's 422, as the limits), named with the

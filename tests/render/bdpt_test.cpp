@@ -47,18 +47,6 @@ const char* kGlassScene = R"(<scene version="3.0.0">
   <emitter type="constant"><rgb name="radiance" value="0.2,0.25,0.3"/></emitter>
 </scene>)";
 
-// The scene rendered by `integrator` with the depths its own integrator has (an integrator given
-// on the command line ignores the file's parameters).
-std::unique_ptr<Scene> load_as(const char* xml, const std::string& integrator) {
-  LoadOptions o;
-  o.integrator = integrator;
-  LoadResult r = load_scene(parse_scene_string(xml, "bdpt_test.xml"), o);
-  const LoadResult own = load_scene(parse_scene_string(xml, "bdpt_test.xml"), LoadOptions{});
-  r.scene->integrator.max_depth = own.scene->integrator.max_depth;
-  r.scene->integrator.rr_depth = own.scene->integrator.rr_depth;
-  return std::move(r.scene);
-}
-
 constexpr int kRenders = 16;
 constexpr double kTMax = 6.0;
 
@@ -147,23 +135,6 @@ TEST(Bdpt, RefusesWhatNeedsAPixelsOwnNoise) {
   EXPECT_THROW(render(*scene, s), std::invalid_argument);
 }
 
-// A room lit only by a point light inside a glass ball: every light path leaves through the glass,
-// which neither next-event estimation nor a BSDF-sampled ray can cross to a point. The path tracer
-// renders it black; bdpt and ptracer light it (light subpaths through the glass, then connections).
-const char* kCagedLight = R"(<scene version="3.0.0">
-  <integrator type="path"><integer name="max_depth" value="8"/></integrator>
-  <sensor type="perspective"><float name="fov" value="70"/>
-    <transform name="to_world"><lookat origin="0,1,1.4" target="0,0.8,0" up="0,1,0"/></transform>
-    <sampler type="independent"/>
-    <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="12"/></film>
-  </sensor>
-  <shape type="cube"><transform name="to_world"><scale x="1.5" y="1" z="1.5"/><translate y="1"/></transform>
-    <boolean name="flip_normals" value="true"/><bsdf type="diffuse"/></shape>
-  <shape type="sphere"><point name="center" x="0" y="1.2" z="-0.5"/><float name="radius" value="0.3"/><bsdf type="dielectric"/></shape>
-  <emitter type="point"><point name="position" x="0" y="1.2" z="-0.5"/><rgb name="intensity" value="3"/></emitter>
-  EXTRA
-</scene>)";
-
 double green_mean(const Film& film) {
   double sum = 0;
   for (int y = film.window().y0; y < film.window().y1; ++y)
@@ -177,7 +148,7 @@ void expect_finite(const Film& film, const std::string& what) {
 }
 
 Film render_caged(const std::string& integrator, const std::string& extra, RenderStats* stats) {
-  std::string xml = kCagedLight;
+  std::string xml = kCagedLightScene;
   xml.replace(xml.find("EXTRA"), 5, extra);
   return render(*load_as(xml.c_str(), integrator), render_settings(16, 3), {}, stats);
 }

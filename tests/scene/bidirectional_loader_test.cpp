@@ -5,6 +5,7 @@
 #include "tessera/scene/load_context.h"
 #include "tessera/scene/scene_desc.h"
 
+#include "integrator_loading.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -16,23 +17,13 @@ namespace {
 
 using test::scene_error_of;
 
-const char* kPerspective = R"(<sensor type="perspective"><float name="fov" value="40"/>
-  <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film></sensor>
-)";
+using test::count_messages;
 
-// The integrator is on line 2 and its parameters follow one per line, so parameter i (from 0)
-// is on line 3 + i.
+const std::string kPerspective = test::kPerspectiveSensor;
+
 LoadResult load(const std::string& integrator, const std::string& rest = kPerspective,
                 const std::string& version = "0.6.0", LoadOptions opt = {}) {
-  const std::string xml = "<scene version=\"" + version + "\">\n" + integrator + "\n" + rest +
-                          "<shape type=\"sphere\"/>\n</scene>\n";
-  return load_scene(parse_scene_string(xml, "mem/bidir.xml"), opt);
-}
-
-size_t count_messages(const LoadResult& r, LoadMessage::Level level, const std::string& text) {
-  size_t n = 0;
-  for (const auto& m : r.messages) n += m.level == level && m.text.find(text) != std::string::npos;
-  return n;
+  return test::load_integrator("mem/bidir.xml", integrator, rest, version, opt);
 }
 
 TEST(BidirectionalLoader, BdptMapsMitsuba06Parameters) {

@@ -72,7 +72,7 @@ TEST(MediumLoader, VolpathWithoutMediaIsThePathTracer) {
 }
 
 TEST(MediumLoader, UnimplementedIntegratorsAreSubstitutedWithANote) {
-  for (const char* type : {"sppm", "pssmlt", "photonmapper", "vpl"}) {
+  for (const char* type : {"ppm", "pssmlt", "photonmapper", "vpl"}) {
     LoadResult r = load(std::string("<integrator type=\"") + type +
                         "\"><integer name=\"maxDepth\" value=\"9\"/><boolean name=\"lightImage\" value=\"true\"/>"
                         "<integer name=\"photonCount\" value=\"1000\"/></integrator>\n" + kGlassWithMedium);
@@ -82,7 +82,7 @@ TEST(MediumLoader, UnimplementedIntegratorsAreSubstitutedWithANote) {
     EXPECT_EQ(count_messages(r, LoadMessage::Level::Note, "caustics of point lights"), 1u) << type;
   }
   // Without media the substitute is the plain path tracer.
-  EXPECT_EQ(load("<integrator type=\"sppm\"/>\n<shape type=\"sphere\"/>").scene->integrator.type, IntegratorType::Path);
+  EXPECT_EQ(load("<integrator type=\"ppm\"/>\n<shape type=\"sphere\"/>").scene->integrator.type, IntegratorType::Path);
 }
 
 TEST(MediumLoader, ReferencedMediaBareBoundariesAndTheCameraMedium) {

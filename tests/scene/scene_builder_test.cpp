@@ -98,7 +98,7 @@ TEST(SceneBuilder, OverridesFromOptions) {
   EXPECT_EQ(load(body, opt).scene->integrator.type, IntegratorType::Bdpt);
   opt.integrator = "bpdt";
   const std::string e = scene_error_of([&] { load(body, opt); });
-  EXPECT_NE(e.find("unknown integrator 'bpdt' (use path, volpath, direct, bdpt or ptracer)"), std::string::npos) << e;
+  EXPECT_NE(e.find("unknown integrator 'bpdt' (use path, volpath, direct, bdpt, ptracer, sppm or vcm)"), std::string::npos) << e;
 }
 
 TEST(SceneBuilder, DefaultIntegratorDependsOnVersion) {

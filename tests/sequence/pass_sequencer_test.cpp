@@ -6,6 +6,7 @@
 #include "toy_technique.h"
 
 #include "tessera/sequence/pass_schedule.h"
+#include "tessera/sequence/photon_program.h"
 
 #include <gtest/gtest.h>
 
@@ -246,7 +247,7 @@ TEST(PassProgram, FlawsAreNamed) {
   EXPECT_NE(flaw([](PassProgram& q) { q.passes[4].film = 2; }).find("no such film"), std::string::npos);
   EXPECT_NE(flaw([](PassProgram& q) { q.passes[2].adaptive = true, q.passes[2].barrier = true; }).find("Paths"),
             std::string::npos);
-  EXPECT_NE(flaw([](PassProgram& q) { q.passes[3].tile_state = true; }).find("state"), std::string::npos);
+  EXPECT_NE(flaw([](PassProgram& q) { q.passes[0].tile_state = true; }).find("state"), std::string::npos);
   EXPECT_NE(flaw([](PassProgram& q) { q.passes[7].adaptive = false; }).find("adaptive"), std::string::npos);
   EXPECT_NE(flaw([](PassProgram& q) { q.combine = FilmCombine::Sum; }).find("Sum"), std::string::npos);
   EXPECT_THROW(PassSequencer(everything_program(), toy_frame(8)), std::invalid_argument) << "artifacts need a builder";
@@ -280,3 +281,48 @@ TEST(PassProgram, APassOfTheSameSamplesFollowsItsTilePass) {
 
 }  // namespace
 }  // namespace tessera::test
+
+namespace tessera {
+namespace {
+
+// A photon mapper's program (photon_program.h): a photon pass feeds the iteration its gather
+// renders with, so iteration 0 is made at the gather's barrier, not at the start; photon units
+// are ranges of the pass's own photons; a gather starts from its tile's previous gather, across
+// the photon pass between them; only the gathers' samples are the render's.
+TEST(PassSequencer, APhotonPassFeedsTheGatherAfterIt) {
+  PassProgram p = photon_program(2, 120);
+  p.paths_per_unit = 50;
+  ASSERT_EQ(program_error(p), "");
+  PassSequencer seq(p, test::toy_frame(8), std::make_unique<GridBuilder<Photon>>([](uint32_t) { return 0.5f; }));
+  const uint64_t pixels = uint64_t(seq.frame().window.area());
+  EXPECT_EQ(seq.planned_samples(), 2 * pixels);
+  ASSERT_EQ(seq.units_in(0), 3u);
+  EXPECT_FALSE(seq.take_artifact()) << "iteration 0 waits for its photons";
+  EXPECT_EQ(seq.open_passes(), 1u);
+  const UnitWork last = seq.work(seq.unit(2, 2));
+  EXPECT_EQ(std::pair(last.path_begin, last.path_end), std::pair(uint64_t(100), uint64_t(120)));
+  EXPECT_EQ(last.sample_begin, 1u) << "the photons of pass 1";
+  for (uint32_t i = 0; i < 3; ++i) {
+    Photon ph{{float(i), 0.f, 0.f}, {1.f, 1.f, 1.f}, 0, {0, 0}, 2};
+    UnitResult r;
+    r.splats.reset(seq.frame().window);
+    r.records = grid_records(std::vector<Photon>{ph, ph});
+    ASSERT_TRUE(seq.add_result(seq.unit(0, i), std::move(r)));
+  }
+  auto made = seq.take_artifact();
+  ASSERT_TRUE(made);
+  EXPECT_EQ(made->iteration, 0u);
+  EXPECT_EQ(static_cast<const PhotonMapArtifact*>(made->artifact.get())->grid().size(), 6u);
+  seq.artifact_stored(0, "h0");
+  EXPECT_EQ(seq.open_passes(), 3u) << "the gather, and the next photon pass beside it";
+  UnitResult gathered;
+  gathered.tile.reset(seq.tiles()[1]);
+  gathered.tile_state = "state of tile 1";
+  ASSERT_TRUE(seq.add_result(seq.unit(1, 1), std::move(gathered)));
+  const UnitWork next = seq.work(seq.unit(3, 1));
+  ASSERT_NE(next.tile_state, nullptr);
+  EXPECT_EQ(*next.tile_state, "state of tile 1") << "across the photon pass between the gathers";
+}
+
+}  // namespace
+}  // namespace tessera

@@ -2,6 +2,9 @@
 // pixel sample, and the light tracer's directly visible emitters.
 #include "render/bdpt_subpath.h"
 #include "render/bounce_samples.h"
+#include "render/octahedral.h"
+#include "tessera/render/sppm.h"
+#include "tessera/render/vcm.h"
 
 #include <algorithm>
 #include <cmath>
@@ -17,9 +20,10 @@ struct CameraPath {
   Rgb beta{1.f};
   float eta = 1.f;
   int length = 1;  // segments up to the vertex being visited
-  float d_vcm = 0.f, d_vc = 0.f;
+  float d_vcm = 0.f, d_vc = 0.f, d_vm = 0.f;
   LightSampleContext prev_ctx;
   float time = 0.f;
+  bool specular = true;  // every vertex so far was delta (vcm's photon mapping mode)
 };
 
 // What a camera vertex needs besides its interaction.
@@ -29,15 +33,19 @@ struct CameraVertex {
   Vec3 wo;  // local
 };
 
+// bdpt, and vcm's camera half (vcm.h) when an iteration to merge with is given.
 class BdptIntegrator final : public Integrator {
  public:
-  explicit BdptIntegrator(const IntegratorSettings& s) : s_(s), light_image_(traces_light_paths(s)) {}
+  explicit BdptIntegrator(const IntegratorSettings& s, const VcmIteration& it = {})
+      : s_(s), light_image_(traces_light_paths(s)), it_(it), mw_(bdpt::vcm_weights(s, it)),
+        connect_(!(it.radius > 0.f) || s.connect), merge_(it.map && it.radius > 0.f && s.merge) {}
 
   Rgb li(const Scene& scene, const Ray& camera_ray, Sampler& sampler, RenderCounters& counters, const PathGuide*,
          SampleFeatures*) const override {
     if (s_.max_depth == 0) return {};
     thread_local bdpt::LightSubpath light;
-    bdpt::trace_light_subpath(scene, s_, sampler, camera_ray.time, light, counters);
+    light.vertices.clear();
+    if (connect_) bdpt::trace_light_subpath(scene, s_, sampler, camera_ray.time, light, counters, mw_);
     CameraPath c;
     c.time = camera_ray.time;
     float pdf_pos = 0.f, pdf_dir = 0.f;
@@ -48,7 +56,7 @@ class BdptIntegrator final : public Integrator {
     SurfaceInteraction si;
     for (;;) {
       if (!scene.intersect(ray, si)) {
-        L += c.beta * environment(scene, c, normalize(ray.d));
+        if (connect_ || c.specular) L += c.beta * environment(scene, c, normalize(ray.d));
         break;
       }
       const float dist = si.t * length(ray.d);
@@ -57,7 +65,9 @@ class BdptIntegrator final : public Integrator {
       const float inv = cos_in > 0.f ? 1.f / mis(cos_in) : 0.f;
       c.d_vcm *= mis(dist * dist) * inv;
       c.d_vc *= inv;
-      if (const Light* area = si.area_light()) L += c.beta * emission(scene, c, si, *area, wo_world, dist);
+      c.d_vm *= inv;
+      if (const Light* area = si.area_light(); area && (connect_ || c.specular))
+        L += c.beta * emission(scene, c, si, *area, wo_world, dist);
       if (s_.max_depth >= 0 && c.length >= s_.max_depth) break;
       if (!reconcile_shading_frame(si, wo_world, s_.strict_normals)) break;
       const Bsdf* bsdf = si.bsdf();
@@ -65,9 +75,11 @@ class BdptIntegrator final : public Integrator {
       const CameraVertex v{&si, bsdf, si.to_local(wo_world)};
       const BounceSamples u = BounceSamples::draw(sampler);
       if (!bsdf->is_delta()) {
-        if (s_.sample_direct && (s_.max_depth < 0 || c.length + 1 <= s_.max_depth))
+        if (connect_ && s_.sample_direct && (s_.max_depth < 0 || c.length + 1 <= s_.max_depth))
           L += c.beta * direct(scene, c, v, u, counters);
         L += c.beta * connect(scene, c, v, light, counters);
+        if (merge_) L += c.beta * merge(c, v);
+        if (!connect_) break;  // (photon mapping: the first non-delta vertex merges everything)
       }
       if (!scatter(c, v, u, ray)) break;
       ++counters.bounce_rays;
@@ -119,13 +131,12 @@ class BdptIntegrator final : public Integrator {
   Rgb direct(const Scene& scene, const CameraPath& c, const CameraVertex& v, const BounceSamples& u,
              RenderCounters& counters) const {
     const SurfaceInteraction& si = *v.si;
-    float pmf = 0.f;
-    const Light* light = scene.sample_light({si.p, si.shading.n}, u.u_pick, pmf);
-    LightSample ls;
-    ls.defer_li = true;
-    if (!light || !(pmf > 0.f) || !light->sample_li(si.p, u.u_light, ls) || !(ls.pdf > 0.f)) return {};
-    const Vec3 wi = si.to_local(ls.wi);
-    if (!consistent_side(si, ls.wi, wi)) return {};
+    bdpt::DirectSample d;
+    if (!bdpt::sample_direct(scene, si, u.u_pick, u.u_light, d)) return {};
+    const Light* light = d.light;
+    const LightSample& ls = d.ls;
+    const float pmf = d.pmf;
+    const Vec3 wi = d.wi;
     const Rgb f = v.bsdf->eval(si, v.wo, wi);
     if (f.is_black()) return {};
     const bool delta_pos = ls.delta && ls.dist < kInfinity;
@@ -140,14 +151,11 @@ class BdptIntegrator final : public Integrator {
     const float cos_to_light = std::abs(dot(si.ng, ls.wi));
     const float w_light = mis(pdf_fwd / (pmf * direct_w));
     const float w_camera = cos_at_light > 0.f ? mis(emission_w * cos_to_light / (pmf * direct_w * cos_at_light)) *
-                                                   (c.d_vcm + c.d_vc * mis(pdf_rev))
+                                                   (c.d_vcm + c.d_vc * mis(pdf_rev) + mw_.vm)
                                              : 0.f;
-    Ray shadow = ls.dist < kInfinity ? spawn_ray_to(si, ls.p_light, ls.p_light_error, ls.n_light) : spawn_ray(si, ls.wi);
-    shadow.time = c.time;
-    ++counters.shadow_rays;
-    const float tr = scene.transmittance(shadow);
+    const float tr = bdpt::direct_transmittance(scene, si, ls, c.time, counters);
     if (!(tr > 0.f)) return {};
-    const Rgb li = ls.li_deferred ? light->deferred_li(ls) : ls.li;
+    const Rgb li = d.li();
     return f * li * (tr * bdpt::strategy_weight(s_, 1, c.length + 1, 1.f / (w_light + 1.f + w_camera)) / (pmf * ls.pdf));
   }
 
@@ -172,8 +180,8 @@ class BdptIntegrator final : public Integrator {
       const float pdf_c_fwd = v.bsdf->pdf(si, v.wo, wi), pdf_c_rev = v.bsdf->pdf(si, wi, v.wo);
       const float pdf_l_fwd = lv.bsdf->pdf(lv.si, lv.wo, wl), pdf_l_rev = lv.bsdf->pdf(lv.si, wl, lv.wo);
       const float cos_c = std::abs(dot(si.ng, dir)), cos_l = std::abs(dot(lv.si.ng, dir));
-      const float w_light = mis(pdf_c_fwd * cos_l / dist2) * (lv.d_vcm + lv.d_vc * mis(pdf_l_rev));
-      const float w_camera = mis(pdf_l_fwd * cos_c / dist2) * (c.d_vcm + c.d_vc * mis(pdf_c_rev));
+      const float w_light = mis(pdf_c_fwd * cos_l / dist2) * (lv.d_vcm + lv.d_vc * mis(pdf_l_rev) + mw_.vm);
+      const float w_camera = mis(pdf_l_fwd * cos_c / dist2) * (c.d_vcm + c.d_vc * mis(pdf_c_rev) + mw_.vm);
       Ray shadow = spawn_ray_to(si, lv.si.p, lv.si.p_error, lv.si.ng);
       shadow.time = c.time;
       ++counters.shadow_rays;
@@ -195,11 +203,14 @@ class BdptIntegrator final : public Integrator {
     const float cos_out = std::abs(dot(si.ng, wi));
     if (bs.delta) {
       c.d_vc *= mis(cos_out);
+      c.d_vm *= mis(cos_out);
       c.d_vcm = 0.f;
     } else {
       const float pdf_rev = v.bsdf->pdf(si, bs.wi, v.wo);
-      c.d_vc = mis(cos_out / bs.pdf) * (c.d_vc * mis(pdf_rev) + c.d_vcm);
+      c.d_vc = mis(cos_out / bs.pdf) * (c.d_vc * mis(pdf_rev) + c.d_vcm + mw_.vm);
+      c.d_vm = mis(cos_out / bs.pdf) * (c.d_vm * mis(pdf_rev) + c.d_vcm * mw_.vc + 1.f);
       c.d_vcm = mis(1.f / bs.pdf);
+      c.specular = false;
     }
     c.beta *= bs.weight;
     c.eta *= bs.eta;
@@ -217,8 +228,38 @@ class BdptIntegrator final : public Integrator {
     return true;
   }
 
+  // Vertex merging (vcm.h) at a non-delta camera vertex: the iteration's light vertices within
+  // its radius, each weighted against every connection and every other merge (or, photon
+  // mapping, with weight 1).
+  Rgb merge(const CameraPath& c, const CameraVertex& v) const {
+    const SurfaceInteraction& si = *v.si;
+    const Vec3 wo_world = si.to_world(v.wo);
+    const Vec3 n_side = dot(si.ng, wo_world) >= 0.f ? si.ng : -si.ng;
+    Rgb sum;
+    it_.map->for_each_near(si.p, it_.radius, [&](const LightVertexRecord& lv) {
+      if (s_.max_depth >= 0 && int(lv.length) + c.length > s_.max_depth) return;
+      if (dot(bdpt::record_normal(lv.n), n_side) < bdpt::kMinMergeNormalCos) return;
+      const Vec3 wi_world = octahedral::decode(lv.wo, 16);
+      const Vec3 wi = si.to_local(wi_world);
+      if (!consistent_side(si, wi_world, wi) || !(std::abs(wi.z) > 1e-6f)) return;
+      const Rgb f = v.bsdf->eval(si, v.wo, wi);
+      if (f.is_black()) return;
+      float w = 1.f;
+      if (connect_) {
+        const float w_light = lv.d_vcm * mw_.vc + lv.d_vm * mis(v.bsdf->pdf(si, v.wo, wi));
+        const float w_camera = c.d_vcm * mw_.vc + c.d_vm * mis(v.bsdf->pdf(si, wi, v.wo));
+        w = 1.f / (w_light + 1.f + w_camera);
+      }
+      sum += f * Rgb(lv.beta[0], lv.beta[1], lv.beta[2]) * (w / std::abs(wi.z));  // (eval has the cosine)
+    });
+    return sum * float(1.0 / (M_PI * double(it_.radius) * double(it_.radius) * it_.light_paths));
+  }
+
   IntegratorSettings s_;
   bool light_image_;
+  VcmIteration it_;
+  bdpt::MisWeights mw_;
+  bool connect_, merge_;
 };
 
 // ptracer's camera side: what the camera sees directly (s = 0 at the first hit); the light
@@ -246,7 +287,8 @@ class DirectlyVisibleEmitters final : public Integrator {
 }  // namespace
 
 bool traces_light_paths(const IntegratorSettings& s) {
-  return s.type == IntegratorType::Ptracer || (s.type == IntegratorType::Bdpt && s.light_image);
+  return s.type == IntegratorType::Ptracer || (s.type == IntegratorType::Bdpt && s.light_image) ||
+         (s.type == IntegratorType::Vcm && s.light_image && s.connect);
 }
 
 std::vector<std::pair<int, int>> bdpt_strategies(int max_length) {
@@ -259,6 +301,14 @@ std::vector<std::pair<int, int>> bdpt_strategies(int max_length) {
 
 std::unique_ptr<Integrator> make_bdpt_integrator(const IntegratorSettings& settings) {
   return std::make_unique<BdptIntegrator>(settings);
+}
+
+float vcm_radius(const Scene& scene, uint32_t iteration) {
+  return sppm_initial_radius(scene) / std::pow(float(iteration) + 1.f, 0.5f * (1.f - scene.integrator.alpha));
+}
+
+std::unique_ptr<Integrator> make_vcm_integrator(const IntegratorSettings& settings, const VcmIteration& it) {
+  return std::make_unique<BdptIntegrator>(settings, it);
 }
 
 std::unique_ptr<Integrator> make_ptracer_integrator(const IntegratorSettings& settings) {

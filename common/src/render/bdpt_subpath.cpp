@@ -1,6 +1,8 @@
 // Light subpaths and the adjoint BSDF (bdpt_subpath.h).
 #include "render/bdpt_subpath.h"
 
+#include "render/octahedral.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -52,16 +54,42 @@ bool survives(const IntegratorSettings& s, int length, Rgb& beta, float beta0, f
 // from this point (it depends on the point under a light hierarchy).
 // Without next-event estimation (sampleDirect off) that strategy's ratio is zero.
 void arrive(const Scene& scene, const IntegratorSettings& s, const LightOrigin& o, const SurfaceInteraction& si,
-            float dist, int length, float& d_vcm, float& d_vc) {
+            float dist, int length, float& d_vcm, float& d_vc, float& d_vm) {
   const float cos_in = std::abs(dot(si.ng, si.wo));
   if (length == 1) d_vcm = s.sample_direct ? mis(direct_pdf(scene, si, o) / o.emission_pdf) : 0.f;
   if (length > 1 || !o.emission.infinite) d_vcm *= mis(dist * dist);
   const float inv = cos_in > 0.f ? 1.f / mis(cos_in) : 0.f;
   d_vcm *= inv;
   d_vc *= inv;
+  d_vm *= inv;
 }
 
 }  // namespace
+
+Vec3 record_normal(const uint8_t n[2]) { return octahedral::decode((uint32_t(n[0]) << 8) | n[1], 8); }
+
+void encode_record_normal(Vec3 ng, Vec3 w, uint8_t out[2]) {
+  const uint32_t n8 = octahedral::encode(dot(ng, w) >= 0.f ? ng : -ng, 8);
+  out[0] = uint8_t(n8 >> 8);
+  out[1] = uint8_t(n8 & 0xFF);
+}
+
+bool sample_direct(const Scene& scene, const SurfaceInteraction& si, float u_pick, Vec2 u_light, DirectSample& out) {
+  out.light = scene.sample_light({si.p, si.shading.n}, u_pick, out.pmf);
+  out.ls = LightSample{};
+  out.ls.defer_li = true;
+  if (!out.light || !(out.pmf > 0.f) || !out.light->sample_li(si.p, u_light, out.ls) || !(out.ls.pdf > 0.f)) return false;
+  out.wi = si.to_local(out.ls.wi);
+  return consistent_side(si, out.ls.wi, out.wi);
+}
+
+float direct_transmittance(const Scene& scene, const SurfaceInteraction& si, const LightSample& ls, float time,
+                           RenderCounters& counters) {
+  Ray shadow = ls.dist < kInfinity ? spawn_ray_to(si, ls.p_light, ls.p_light_error, ls.n_light) : spawn_ray(si, ls.wi);
+  shadow.time = time;
+  ++counters.shadow_rays;
+  return scene.transmittance(shadow);
+}
 
 float direct_pdf(const Scene& scene, const SurfaceInteraction& si, const LightOrigin& o) {
   const LightEmission& e = o.emission;
@@ -81,7 +109,7 @@ float direct_pdf(const Scene& scene, const SurfaceInteraction& si, const LightOr
 }
 
 void trace_light_subpath(const Scene& scene, const IntegratorSettings& s, Sampler& sampler, float time,
-                         LightSubpath& out, RenderCounters& counters) {
+                         LightSubpath& out, RenderCounters& counters, const MisWeights& mw) {
   out.vertices.clear();
   const uint32_t saved = sampler.dimension();
   sampler.set_dimension(Sampler::kLightDimension);
@@ -93,7 +121,7 @@ void trace_light_subpath(const Scene& scene, const IntegratorSettings& s, Sample
   const LightOrigin& o = out.origin;
   const float beta0 = beta.max_value();
   const float cos_light = (o.emission.infinite || o.emission.delta_pos) ? 1.f : std::abs(dot(o.emission.n, o.emission.dir));
-  float d_vcm = 0.f, d_vc = o.delta ? 0.f : mis(cos_light / o.emission_pdf);
+  float d_vcm = 0.f, d_vc = o.delta ? 0.f : mis(cos_light / o.emission_pdf), d_vm = d_vc * mw.vc;
   Ray ray = emission_ray(o.emission, time);
   ++counters.bounce_rays;
   Vertex v;
@@ -101,7 +129,7 @@ void trace_light_subpath(const Scene& scene, const IntegratorSettings& s, Sample
     if (!scene.intersect(ray, v.si)) break;
     const Vec3 w_prev = -ray.d;
     if (!reconcile_shading_frame(v.si, w_prev, s.strict_normals)) break;
-    arrive(scene, s, o, v.si, v.si.t * length(ray.d), len, d_vcm, d_vc);
+    arrive(scene, s, o, v.si, v.si.t * length(ray.d), len, d_vcm, d_vc, d_vm);
     const Bsdf* bsdf = v.si.bsdf();
     if (!bsdf) break;
     v.bsdf = bsdf;
@@ -111,6 +139,7 @@ void trace_light_subpath(const Scene& scene, const IntegratorSettings& s, Sample
     v.length = len;
     v.d_vcm = d_vcm;
     v.d_vc = d_vc;
+    v.d_vm = d_vm;
     v.u_lens = sampler.next_2d();
     const float u_lobe = sampler.next_1d();
     const Vec2 u_dir = sampler.next_2d();
@@ -126,11 +155,14 @@ void trace_light_subpath(const Scene& scene, const IntegratorSettings& s, Sample
     if (bs.delta) {
       beta *= adjoint_weight(v.si, bs, v.wo_world, wi);
       d_vc *= mis(cos_out);
+      d_vm *= mis(cos_out);
       d_vcm = 0.f;
     } else {
       beta *= adjoint_eval(v.si, *bsdf, v.wo_world, wi) * (1.f / bs.pdf);
       const float pdf_rev = bsdf->pdf(v.si, bs.wi, v.wo);
-      d_vc = mis(cos_out / bs.pdf) * (d_vc * mis(pdf_rev) + d_vcm);
+      // (Georgiev's updates; without merging, mw.vm is 0 and d_vc is bdpt's to the bit.)
+      d_vc = mis(cos_out / bs.pdf) * (d_vc * mis(pdf_rev) + d_vcm + mw.vm);
+      d_vm = mis(cos_out / bs.pdf) * (d_vm * mis(pdf_rev) + d_vcm * mw.vc + 1.f);
       d_vcm = mis(1.f / bs.pdf);
     }
     if (!survives(s, len, beta, beta0, u_rr)) break;

@@ -3,14 +3,18 @@
 // MIS (Georgiev 2012, power heuristic): every vertex carries
 //   d_vcm  1 / (density with which the subpath's own direction sampled this vertex, area measure),
 //          times the weight ratio of the strategy that would have ended the other subpath here;
-//   d_vc   the sum of the ratios of the strategies with more vertices on the other side.
-// Both are squared quantities already (mis()). A strategy's weight is 1 / (1 + the ratios of every
-// other strategy), each ratio built from these at the two ends of the connection.
+//   d_vc   the sum of the ratios of the connections with more vertices on the other side;
+//   d_vm   the same for the merges (vertex merging: vcm.h), zero without them.
+// All are squared quantities already (mis()). A strategy's weight is 1 / (1 + the ratios of every
+// other strategy), each ratio built from these at the two ends of the connection or merge.
+// MisWeights carries vertex merging's two constants (Georgiev's eta_vcm = pi r^2 light paths):
+// with merging off both are 0 and every quantity is bdpt's, bit for bit.
 #pragma once
 
 #include "tessera/render/bdpt.h"
 #include "tessera/render/bsdf_adjoint.h"
 #include "tessera/render/interaction.h"
+#include "tessera/render/vcm.h"
 
 #include <vector>
 
@@ -28,6 +32,26 @@ inline float strategy_weight(const IntegratorSettings& settings, int s, int t, f
   return settings.only_weighted ? mis_weight : 1.f;
 }
 
+/// Vertex merging's MIS constants for one iteration: vm = mis(eta_vcm) when merging (0: off),
+/// vc = mis(1 / eta_vcm) when connecting.
+struct MisWeights {
+  float vm = 0.f, vc = 0.f;
+};
+
+/// The constants of iteration `it` of a vcm render that merges (none for bdpt: radius 0).
+inline MisWeights vcm_weights(const IntegratorSettings& s, const VcmIteration& it) {
+  if (!(it.radius > 0.f)) return {};
+  const float eta = float(3.14159265358979323846 * double(it.radius) * double(it.radius) * it.light_paths);
+  return {s.merge ? mis(eta) : 0.f, s.connect ? mis(1.f / eta) : 0.f};
+}
+
+/// A merge (or a photon's gather) counts only where the surfaces face within about 60 degrees.
+inline constexpr float kMinMergeNormalCos = 0.5f;
+/// The unit normal of a record's 8:8 octahedral bytes.
+Vec3 record_normal(const uint8_t n[2]);
+/// Those bytes for `ng` turned to the side `w` arrives from.
+void encode_record_normal(Vec3 ng, Vec3 w, uint8_t out[2]);
+
 struct Vertex {
   SurfaceInteraction si;
   const Bsdf* bsdf = nullptr;
@@ -35,7 +59,7 @@ struct Vertex {
   Vec3 wo_world;
   Rgb beta;        // light: emitted power along the subpath; camera: throughput
   int length = 0;  // segments from the subpath's origin
-  float d_vcm = 0.f, d_vc = 0.f;
+  float d_vcm = 0.f, d_vc = 0.f, d_vm = 0.f;
   Vec2 u_lens;     // light vertices: the lens sample of its camera connection
 };
 
@@ -55,14 +79,31 @@ struct LightSubpath {
 
 /// Traces the light subpath of the sampler's pixel sample from Sampler::kLightDimension, up to
 /// the length a path of at most settings.max_depth segments can use; the sampler's dimension is
-/// restored afterwards.
+/// restored afterwards. `weights`: vertex merging's (none: bdpt).
 void trace_light_subpath(const Scene& scene, const IntegratorSettings& settings, Sampler& sampler, float time,
-                         LightSubpath& out, RenderCounters& counters);
+                         LightSubpath& out, RenderCounters& counters, const MisWeights& weights = {});
 
 /// Next-event estimation's density at the surface point `si` of picking the subpath's origin: per
 /// unit area at the origin for finite lights, per unit solid angle for distant ones, the light's
 /// selection pmf alone for a delta position or direction.
 float direct_pdf(const Scene& scene, const SurfaceInteraction& si, const LightOrigin& origin);
+
+/// Next-event estimation's light sample at a surface point: the light picked as `path` picks it,
+/// its sample, and the sample's direction in the shading frame.
+struct DirectSample {
+  const Light* light = nullptr;
+  float pmf = 0.f;
+  LightSample ls;
+  Vec3 wi;  // local
+  /// The light's radiance along the sample (deferred_li when the light deferred it).
+  Rgb li() const { return ls.li_deferred ? light->deferred_li(ls) : ls.li; }
+};
+/// False when there is no sample, or its direction lies on different sides of the geometric and
+/// the shading surface.
+bool sample_direct(const Scene& scene, const SurfaceInteraction& si, float u_pick, Vec2 u_light, DirectSample& out);
+/// The transmittance of the shadow ray from `si` to the sample's point, at `time`.
+float direct_transmittance(const Scene& scene, const SurfaceInteraction& si, const LightSample& ls, float time,
+                           RenderCounters& counters);
 
 /// Light::pdf_le as light subpaths start: for a distant light, pdf_pos is the scene's emission
 /// portal's density of the line through `on_line` along `dir` (the direction of travel) when the

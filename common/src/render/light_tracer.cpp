@@ -1,6 +1,7 @@
 // Light tracing units (bdpt.h): light subpaths connected to the camera (t = 1) and splatted onto
 // the window through the pixel filter.
 #include "render/bdpt_subpath.h"
+#include "render/octahedral.h"
 
 #include "tessera/core/check.h"
 #include "tessera/render/render_tile.h"
@@ -67,7 +68,7 @@ namespace {
 
 // t = 1 at one light vertex: its importance from the camera, MIS-weighted (bdpt) against the
 // camera's subpath sampling this vertex (t >= 2).
-void connect_to_camera(const Scene& scene, const bdpt::Vertex& v, float time, bool weighted, LightSplats& out) {
+void connect_to_camera(const Scene& scene, const bdpt::Vertex& v, float time, bool weighted, float vm, LightSplats& out) {
   CameraSampleWi cs;
   if (!scene.camera->sample_wi(v.si.p, v.u_lens, time, cs) || !(cs.pdf > 0.f)) return;
   const Rgb f = adjoint_eval(v.si, *v.bsdf, v.wo_world, cs.wi);
@@ -80,7 +81,7 @@ void connect_to_camera(const Scene& scene, const bdpt::Vertex& v, float time, bo
     scene.camera->pdf_we(from_camera, pdf_pos, pdf_dir);
     const float camera_pdf_a = pdf_dir * std::abs(dot(v.si.ng, cs.wi)) / (cs.dist * cs.dist);
     const float pdf_rev = v.bsdf->pdf(v.si, v.si.to_local(cs.wi), v.wo);
-    w = 1.f / (1.f + bdpt::mis(camera_pdf_a) * (v.d_vcm + v.d_vc * bdpt::mis(pdf_rev)));
+    w = 1.f / (1.f + bdpt::mis(camera_pdf_a) * (v.d_vcm + v.d_vc * bdpt::mis(pdf_rev) + vm));
   }
   Ray shadow = spawn_ray_to(v.si, cs.p_lens, Vec3(0.f), Vec3(0.f));
   shadow.time = time;
@@ -90,14 +91,31 @@ void connect_to_camera(const Scene& scene, const bdpt::Vertex& v, float time, bo
   out.add(cs.raster, v.beta * f * cs.we * (tr * w / cs.pdf), scene.film.filter.get());
 }
 
-}  // namespace
+// A light vertex as vertex merging keeps it.
+LightVertexRecord vertex_record(const bdpt::Vertex& v) {
+  LightVertexRecord r;
+  for (int c = 0; c < 3; ++c) {
+    r.p[c] = v.si.p[c];
+    r.beta[c] = v.beta[c];
+  }
+  r.wo = octahedral::encode(v.wo_world, 16);
+  bdpt::encode_record_normal(v.si.ng, v.wo_world, r.n);
+  r.length = uint16_t(std::min(v.length, 0xFFFF));
+  r.d_vcm = v.d_vcm;
+  r.d_vm = v.d_vm;
+  return r;
+}
 
-void trace_light_paths(const Scene& scene, uint64_t path_begin, uint64_t path_end, uint32_t seed, LightSplats& out) {
+// bdpt's and vcm's light paths: their light tracing and (vcm) their vertices.
+void trace_paths(const Scene& scene, const VcmIteration& it, uint64_t path_begin, uint64_t path_end, uint32_t seed,
+                 LightSplats& out, std::vector<LightVertexRecord>* records) {
   TESSERA_CHECK(scene.camera != nullptr);
   const IntegratorSettings& s = scene.integrator;
   const TileRect& window = out.window();
   const uint64_t pixels = uint64_t(window.area());
-  const bool weighted = s.type == IntegratorType::Bdpt;
+  const bool weighted = s.type == IntegratorType::Bdpt || s.type == IntegratorType::Vcm;
+  const bool splats = traces_light_paths(s);
+  const bdpt::MisWeights mw = bdpt::vcm_weights(s, it);
   Sampler sampler(scene.sampler.type, seed);
   thread_local bdpt::LightSubpath light;
   for (uint64_t k = path_begin; k < path_end; ++k) {
@@ -108,12 +126,25 @@ void trace_light_paths(const Scene& scene, uint64_t path_begin, uint64_t path_en
     const float time = camera_sample_time(scene, sampler);
     ++out.counters.samples;
     if (s.max_depth == 0) continue;
-    bdpt::trace_light_subpath(scene, s, sampler, time, light, out.counters);
+    bdpt::trace_light_subpath(scene, s, sampler, time, light, out.counters, mw);
     for (const bdpt::Vertex& v : light.vertices) {
       if (s.max_depth >= 0 && v.length + 1 > s.max_depth) break;
-      if (bdpt::strategy_weight(s, v.length + 1, 1, 1.f) > 0.f) connect_to_camera(scene, v, time, weighted, out);
+      if (records) records->push_back(vertex_record(v));
+      if (splats && bdpt::strategy_weight(s, v.length + 1, 1, 1.f) > 0.f)
+        connect_to_camera(scene, v, time, weighted, mw.vm, out);
     }
   }
+}
+
+}  // namespace
+
+void trace_light_paths(const Scene& scene, uint64_t path_begin, uint64_t path_end, uint32_t seed, LightSplats& out) {
+  trace_paths(scene, VcmIteration{}, path_begin, path_end, seed, out, nullptr);
+}
+
+void trace_vcm_light_paths(const Scene& scene, const VcmIteration& it, uint64_t path_begin, uint64_t path_end,
+                           uint32_t seed, LightSplats& splats, std::vector<LightVertexRecord>& records) {
+  trace_paths(scene, it, path_begin, path_end, seed, splats, &records);
 }
 
 }  // namespace tessera

@@ -16,6 +16,7 @@
 #include "tessera/render/integrator.h"
 
 #include <algorithm>
+#include <stdexcept>
 
 namespace tessera {
 namespace {
@@ -332,6 +333,11 @@ std::unique_ptr<Integrator> make_integrator(const IntegratorSettings& settings) 
     case IntegratorType::Direct: return make_direct_integrator(settings);
     case IntegratorType::Bdpt: return make_bdpt_integrator(settings);
     case IntegratorType::Ptracer: return make_ptracer_integrator(settings);
+    case IntegratorType::Sppm:
+    case IntegratorType::Vcm:
+      throw std::invalid_argument(std::string("the ") + integrator_name(settings.type) +
+                                  " integrator renders by passes of light and camera units (sequence/photon_program.h), "
+                                  "not by a radiance per camera ray");
     case IntegratorType::Path:
     case IntegratorType::VolPath: break;
   }

@@ -65,7 +65,7 @@ void Scene::finalize() {
     if (l->is_infinite()) infinite_lights_.push_back(l.get());
   }
   light_sampler_.build(lights, shapes, integrator.light_selection);
-  const bool bidirectional = is_bidirectional(integrator.type);
+  const bool bidirectional = is_bidirectional(integrator.type) || uses_light_vertex_passes(integrator.type);
   const bool distant = std::any_of(lights.begin(), lights.end(), [](const auto& l) { return l->is_distant(); });
   emission_portal_ = bidirectional && distant ? find_emission_portal(*this) : EmissionPortal{};
 }

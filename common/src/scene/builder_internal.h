@@ -26,8 +26,6 @@ struct BuildState {
 void build_integrator(BuildState& st);
 /// A `guided_path` integrator's guiding parameters (guided_path_builder.cpp).
 void read_guided_path(BuildState& st, const SceneNode& node);
-/// "path", "volpath", "direct", "bdpt", "ptracer": the name scenes and --integrator use.
-const char* integrator_name(IntegratorType type);
 /// After finish_media: bdpt and ptracer refuse a sensor they cannot importance-sample.
 void check_integrator_sensor(BuildState& st);
 void build_sensor(BuildState& st);  // after the shapes: a missing sensor is fitted to the scene bounds

@@ -4,8 +4,11 @@
 #include "tessera/scene/load_context.h"
 
 #include "scene/builder_internal.h"
+#include "tessera/render/sppm.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <iterator>
 #include <optional>
 
@@ -22,7 +25,8 @@ struct NamedIntegrator {
 // The integrators Tessera has, by the names scenes and --integrator use.
 constexpr NamedIntegrator kOwn[] = {{"path", IntegratorType::Path},       {"volpath", IntegratorType::VolPath},
                                     {"direct", IntegratorType::Direct},   {"bdpt", IntegratorType::Bdpt},
-                                    {"ptracer", IntegratorType::Ptracer}};
+                                    {"ptracer", IntegratorType::Ptracer}, {"sppm", IntegratorType::Sppm},
+                                    {"vcm", IntegratorType::Vcm}};
 
 std::optional<IntegratorType> own_type(const std::string& name) {
   for (const NamedIntegrator& n : kOwn)
@@ -30,7 +34,7 @@ std::optional<IntegratorType> own_type(const std::string& name) {
   return std::nullopt;
 }
 
-/// "path, volpath, direct, bdpt or ptracer"
+/// "path, volpath, direct, bdpt, ptracer, sppm or vcm"
 std::string own_names() {
   std::string out;
   const size_t count = std::size(kOwn);
@@ -41,7 +45,7 @@ std::string own_names() {
 // Mitsuba integrators Tessera does not implement whose image a path tracer converges to as well
 // (except for paths it cannot sample): rendered by the (volume) path tracer with a note.
 bool substituted_by_path_tracer(const std::string& type) {
-  static const char* const kTypes[] = {"pssmlt", "mlt", "erpt", "ppm", "sppm", "photonmapper", "vpl"};
+  static const char* const kTypes[] = {"pssmlt", "mlt", "erpt", "ppm", "photonmapper", "vpl"};
   for (const char* t : kTypes)
     if (type == t) return true;
   return false;
@@ -76,19 +80,35 @@ void read_bdpt(const SceneNode& node, IntegratorSettings& s) {
   s.sample_direct = node.get_bool(name_in(node, "sample_direct", "sampleDirect"), true);
 }
 
+// How many units Mitsuba cuts its work into (0.6's granularity, 3's samples_per_pass): scheduling
+// only; the image does not depend on it. Read always, so that a wrong type is an error.
+void note_scheduling(BuildState& st, const SceneNode& node, const std::string& name) {
+  (void)node.get_int(name, -1);
+  if (const Property* p = node.peek(name))
+    st.ctx.note(p->loc, "parameter '" + p->written_name + "' of " + node.describe() +
+                            " only sets how Mitsuba schedules its work; ignored (the image does not depend on it)");
+}
+
+// A float parameter in [lo, hi] ((lo, hi] with open_lo); outside it, a SceneError at its line.
+float get_float_in(const SceneNode& node, const std::string& name, float def, float lo, float hi, bool open_lo) {
+  const float v = node.get_float(name, def);
+  if (!(open_lo ? v > lo : v >= lo) || !(v <= hi)) {
+    char range[96];
+    if (std::isinf(hi)) std::snprintf(range, sizeof range, "%s %g", open_lo ? ">" : ">=", double(lo));
+    else std::snprintf(range, sizeof range, "in %s%g, %g]", open_lo ? "(" : "[", double(lo), double(hi));
+    throw SceneError(node.loc_of(name), "'" + node.peek(name)->written_name + "' of " + node.describe() + " must be " +
+                                            range + ", got " + std::to_string(v));
+  }
+  return v;
+}
+
 // ptracer: Mitsuba 0.6's maxDepth, rrDepth, granularity, bruteForce and Mitsuba 3's max_depth,
 // rr_depth, hide_emitters, samples_per_pass.
 void read_ptracer(BuildState& st, const SceneNode& node, IntegratorSettings& s) {
   read_depths(node, s, name_in(node, "max_depth", "maxDepth"), name_in(node, "rr_depth", "rrDepth"));
   s.hide_emitters = node.get_bool(name_in(node, "hide_emitters", "hideEmitters"), false);
-  // How many light paths Mitsuba puts in one work unit (0.6) or pass (3): scheduling only; the
-  // total, and so the image, does not depend on it. Read always, so that a wrong type is an error.
-  for (const std::string& name : {std::string("granularity"), name_in(node, "samples_per_pass", "samplesPerPass")}) {
-    (void)node.get_int(name, -1);
-    if (const Property* p = node.peek(name))
-      st.ctx.note(p->loc, "parameter '" + p->written_name + "' of " + node.describe() +
-                              " only sets how Mitsuba schedules its light paths; ignored (the image does not depend on it)");
-  }
+  for (const std::string& name : {std::string("granularity"), name_in(node, "samples_per_pass", "samplesPerPass")})
+    note_scheduling(st, node, name);
   // bruteForce leaves out the connections to the camera (a debugging mode); false is what Tessera does.
   const std::string brute = name_in(node, "brute_force", "bruteForce");
   if (node.get_bool(brute, false))
@@ -96,10 +116,45 @@ void read_ptracer(BuildState& st, const SceneNode& node, IntegratorSettings& s) 
                        "false (every light vertex is connected to the camera)");
 }
 
+// sppm: Mitsuba 0.6's maxDepth, rrDepth (default 3), photonCount, initialRadius, alpha, maxPasses,
+// granularity, under either spelling.
+void read_sppm(BuildState& st, const SceneNode& node, IntegratorSettings& s) {
+  read_depths(node, s, name_in(node, "max_depth", "maxDepth"), name_in(node, "rr_depth", "rrDepth"));
+  if (!node.peek(name_in(node, "rr_depth", "rrDepth"))) s.rr_depth = 3;
+  const std::string count = name_in(node, "photon_count", "photonCount");
+  const int64_t photons = node.get_int(count, 250000);
+  if (photons < 1 || uint64_t(photons) > kMaxPhotonsPerPass)
+    throw SceneError(node.loc_of(count), "'" + node.peek(count)->written_name + "' of " + node.describe() + " is " +
+                                             std::to_string(photons) + ": a pass's photon map holds 1 to " +
+                                             std::to_string(kMaxPhotonsPerPass) + " photons (its cap of " +
+                                             std::to_string(kMaxPhotonMapBytes >> 20) + " MiB at 32 bytes a photon)");
+  s.photon_count = uint64_t(photons);
+  s.initial_radius = get_float_in(node, name_in(node, "initial_radius", "initialRadius"), 0.f, 0.f, kInfinity, false);
+  s.alpha = get_float_in(node, "alpha", 0.7f, 0.f, 1.f, true);
+  const std::string passes = name_in(node, "max_passes", "maxPasses");
+  s.max_passes = int(get_int_in(node, passes, -1, -1, INT32_MAX));
+  if (s.max_passes == 0)
+    throw SceneError(node.loc_of(passes), "'" + passes + "' of " + node.describe() +
+                                              " must be -1 (no limit) or at least 1, got 0");
+  note_scheduling(st, node, "granularity");
+}
+
+// vcm, Tessera's own (Mitsuba has none): bdpt's depths and switches, sppm's radius and alpha
+// (default 0.75, SmallVCM's), merge and connect.
+void read_vcm(const SceneNode& node, IntegratorSettings& s) {
+  read_bdpt(node, s);
+  s.initial_radius = get_float_in(node, "initial_radius", 0.f, 0.f, kInfinity, false);
+  s.alpha = get_float_in(node, "alpha", 0.75f, 0.f, 1.f, true);
+  s.merge = node.get_bool("merge", true);
+  s.connect = node.get_bool("connect", true);
+  if (!s.merge && !s.connect)
+    throw SceneError(node.loc, node.describe() + " with neither merge nor connect has no strategy to render with");
+}
+
 // An integrator given on the command line in place of one that traces paths of a bounded depth
 // keeps that depth: the same light paths, by another method (what comparisons of methods need).
 bool keep_depths(const SceneNode& node, IntegratorSettings& s) {
-  static const char* const kTracers[] = {"path", "volpath", "guided_path", "bdpt", "ptracer"};
+  static const char* const kTracers[] = {"path", "volpath", "guided_path", "bdpt", "ptracer", "sppm", "vcm"};
   if (std::none_of(std::begin(kTracers), std::end(kTracers), [&](const char* t) { return node.type == t; }) &&
       !substituted_by_path_tracer(node.type))
     return false;
@@ -112,18 +167,14 @@ void read_parameters(BuildState& st, const SceneNode& node, IntegratorSettings& 
     case IntegratorType::Direct: read_direct(node, s); break;
     case IntegratorType::Bdpt: read_bdpt(node, s); break;
     case IntegratorType::Ptracer: read_ptracer(st, node, s); break;
+    case IntegratorType::Sppm: read_sppm(st, node, s); break;
+    case IntegratorType::Vcm: read_vcm(node, s); break;
     case IntegratorType::Path:
     case IntegratorType::VolPath: read_path(node, s); break;
   }
 }
 
 }  // namespace
-
-const char* integrator_name(IntegratorType type) {
-  for (const NamedIntegrator& n : kOwn)
-    if (n.type == type) return n.name;
-  return "?";
-}
 
 void build_integrator(BuildState& st) {
   auto nodes = st.desc.root->children_with_tag("integrator");
@@ -150,6 +201,7 @@ void build_integrator(BuildState& st) {
   if (const std::optional<IntegratorType> own = own_type(type)) {
     s.type = *own;  // volpath: finish_media() makes it path when there are no media
     if (node) read_parameters(st, *node, s);
+    else if (s.type == IntegratorType::Sppm && nodes.empty()) s.rr_depth = 3;  // (Mitsuba's sppm's default)
   } else if (type == "guided_path") {
     s.type = IntegratorType::Path;  // (the plugin is a surface path tracer)
     read_guided_path(st, *node);
@@ -170,7 +222,7 @@ void build_integrator(BuildState& st) {
 
 void check_integrator_sensor(BuildState& st) {
   const IntegratorType type = st.scene.integrator.type;
-  if (type != IntegratorType::Bdpt && type != IntegratorType::Ptracer) return;
+  if (!is_bidirectional(type)) return;
   auto sensors = st.desc.root->children_with_tag("sensor");
   if (sensors.empty()) return;  // the camera fitted to the scene is a perspective one
   const SceneNode& sensor = *sensors[0];
@@ -182,3 +234,13 @@ void check_integrator_sensor(BuildState& st) {
 }
 
 }  // namespace tessera::detail
+
+namespace tessera {
+
+const char* integrator_name(IntegratorType type) {
+  for (const detail::NamedIntegrator& n : detail::kOwn)
+    if (n.type == type) return n.name;
+  return "?";
+}
+
+}  // namespace tessera

@@ -48,13 +48,13 @@ void finish_media(BuildState& st) {
   IntegratorSettings& integrator = scene.integrator;
   auto nodes = st.desc.root->children_with_tag("integrator");
   FileLoc loc = nodes.empty() ? st.desc.root->loc : nodes[0]->loc;
-  const bool bidirectional = integrator.type == IntegratorType::Bdpt || integrator.type == IntegratorType::Ptracer;
+  const bool surfaces_only = is_bidirectional(integrator.type) || uses_light_vertex_passes(integrator.type);
   if (integrator.type == IntegratorType::VolPath && !media) {
     integrator.type = IntegratorType::Path;  // the same estimator; no medium dimensions to draw
-  } else if (bidirectional && media) {
-    // Bdpt and Ptracer trace surfaces only; volpath converges to the image they were asked for.
+  } else if (surfaces_only && media) {
+    // Bdpt, Ptracer and Sppm trace surfaces only; volpath converges to the image they were asked for.
     st.ctx.note(loc, std::string("the '") + integrator_name(integrator.type) +
-                         "' integrator does not render participating media (volumetric BDPT is not built): "
+                         "' integrator does not render participating media (volumetric light paths are not built): "
                          "this scene, which has media, is rendered by 'volpath' (the same expected image)");
     integrator.type = IntegratorType::VolPath;
   } else if (integrator.type != IntegratorType::VolPath && media) {

@@ -71,7 +71,7 @@ void FilmAssembler::add_tile(uint32_t pass, uint32_t tile, FilmTile&& result) {
 }
 
 uint64_t FilmAssembler::unit_paths(uint32_t pass, uint32_t index) const {
-  const uint64_t paths = uint64_t(window_.area()) * program_.passes[pass].samples;
+  const uint64_t paths = pass_paths(program_.passes[pass], uint64_t(window_.area()));
   const uint64_t begin = uint64_t(index) * program_.paths_per_unit;
   return begin >= paths ? 0 : std::min(program_.paths_per_unit, paths - begin);
 }

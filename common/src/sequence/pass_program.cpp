@@ -19,12 +19,17 @@ std::string pass_error(const PassProgram& program, size_t p, const std::vector<b
   if ((pass.adaptive || pass.may_stop) && !pass.barrier) return where + "decides at no barrier";
   if (pass.kind == UnitKind::Paths && (pass.adaptive || pass.tile_state))
     return where + "a Paths pass has no per-pixel counts or state";
-  if (pass.tile_state && (p == 0 || program.passes[p - 1].kind != UnitKind::Tile))
+  if (pass.tile_state && std::none_of(program.passes.begin(), program.passes.begin() + std::ptrdiff_t(p),
+                                      [](const PassSpec& q) { return q.kind == UnitKind::Tile; }))
     return where + "its per-pixel state comes from a Tile pass before it";
-  if (pass.same_samples &&
-      (pass.kind != UnitKind::Paths || p == 0 || program.passes[p - 1].kind != UnitKind::Tile ||
-       program.passes[p - 1].sample_begin != pass.sample_begin || program.passes[p - 1].samples != pass.samples))
-    return where + "traces the samples of a Tile pass just before it, which it does not follow";
+  if (pass.photons > 0 && (pass.kind != UnitKind::Paths || pass.same_samples || pass.samples != 0))
+    return where + "a photon pass is a Paths pass of no sample indices";
+  auto same_tile = [&](size_t q) {
+    return q < program.passes.size() && program.passes[q].kind == UnitKind::Tile &&
+           program.passes[q].sample_begin == pass.sample_begin && program.passes[q].samples == pass.samples;
+  };
+  if (pass.same_samples && (pass.kind != UnitKind::Paths || !((p > 0 && same_tile(p - 1)) || same_tile(p + 1))))
+    return where + "traces the samples of a Tile pass just before or after it, which it does not follow or precede";
   if (pass.adaptive && p == 0) return where + "the first pass has no film to adapt to";
   if (pass.uses && *pass.uses > 0 && !used_before[*pass.uses] && !pass.barrier)
     return where + "renders with a new artifact without waiting for it (a barrier)";
@@ -45,7 +50,8 @@ std::string program_error(const PassProgram& program) {
   }
   uint32_t next_sample = 0;  // the passes take the sample indices 0 .. spp-1 in order
   for (size_t p = 0; p < program.passes.size(); ++p) {
-    if (program.passes[p].same_samples && program.passes[p].kind == UnitKind::Paths) continue;  // (pass_error)
+    if (program.passes[p].kind == UnitKind::Paths && (program.passes[p].same_samples || program.passes[p].photons > 0))
+      continue;  // (pass_error)
     if (program.passes[p].sample_begin != next_sample || program.passes[p].samples == 0)
       return "pass " + std::to_string(p) + ": its samples do not follow the pass before's";
     next_sample += program.passes[p].samples;

@@ -28,11 +28,11 @@ PassSequencer::PassSequencer(PassProgram program, const SequenceFrame& frame, st
   const uint64_t pixels = uint64_t(frame.window.area());
   unit_begin_.push_back(0);
   for (const PassSpec& p : program_.passes) {
-    const uint64_t paths = pixels * p.samples;
+    const uint64_t paths = pass_paths(p, pixels);
     const size_t units = p.kind == UnitKind::Tile ? tiles_.size()
                                                  : size_t((paths + program_.paths_per_unit - 1) / program_.paths_per_unit);
     unit_begin_.push_back(unit_begin_.back() + units);
-    total_samples_ += pixels * p.samples;
+    total_samples_ += pixels * p.samples;  // (a photon pass has none)
   }
   done_.assign(num_units(), 0);
   pass_done_.assign(num_passes(), 0);
@@ -40,7 +40,9 @@ PassSequencer::PassSequencer(PassProgram program, const SequenceFrame& frame, st
     tile_states_.resize(num_units());
   if (std::any_of(program_.passes.begin(), program_.passes.end(), [](const PassSpec& p) { return p.adaptive; }))
     plans_.emplace(frame.window, tiles_, program_);
-  if (builder_ && first_user(0)) build_artifact(0);
+  // (An iteration 0 that a pass feeds is made at its first user's barrier, like any later one.)
+  const bool fed0 = std::any_of(program_.passes.begin(), program_.passes.end(), [](const PassSpec& p) { return p.feeds == 0u; });
+  if (builder_ && first_user(0) && !fed0) build_artifact(0);
   advance();
 }
 
@@ -57,9 +59,10 @@ UnitWork PassSequencer::work(size_t unit) const {
   w.kind = spec.kind;
   w.uses = spec.uses;
   w.feeds = spec.feeds;
+  w.sample_begin = spec.sample_begin;
   if (spec.kind == UnitKind::Paths) {
-    const uint64_t first = uint64_t(spec.sample_begin) * uint64_t(frame_.window.area());
-    const uint64_t end = first + uint64_t(spec.samples) * uint64_t(frame_.window.area());
+    const uint64_t first = spec.photons > 0 ? 0 : uint64_t(spec.sample_begin) * uint64_t(frame_.window.area());
+    const uint64_t end = first + pass_paths(spec, uint64_t(frame_.window.area()));
     w.path_begin = first + uint64_t(w.index) * program_.paths_per_unit;
     w.path_end = std::min(end, w.path_begin + program_.paths_per_unit);
     return w;
@@ -68,7 +71,7 @@ UnitWork PassSequencer::work(size_t unit) const {
   w.sample_begin = spec.sample_begin;
   w.sample_end = spec.sample_begin + spec.samples;
   if (spec.adaptive && plans_->is_latest(w.pass)) w.samples = plans_->tile_samples(w.index, w.pass);
-  if (spec.tile_state) w.tile_state = &tile_states_[unit_begin_[w.pass - 1] + w.index];
+  if (spec.tile_state) w.tile_state = &tile_states_[unit_begin_[state_pass(w.pass)] + w.index];
   return w;
 }
 
@@ -76,6 +79,7 @@ uint64_t PassSequencer::unit_samples(size_t unit) const {
   const uint32_t p = pass_of(unit), i = uint32_t(unit - unit_begin_[p]);
   const PassSpec& spec = program_.passes[p];
   if (spec.kind == UnitKind::Paths) {
+    if (spec.photons > 0) return 0;  // (photons are not samples of pixels)
     const UnitWork w = work(unit);
     return w.path_end - w.path_begin;
   }
@@ -87,7 +91,14 @@ bool PassSequencer::ready(size_t unit) const {
   if (stopped_ || done_[unit]) return false;
   const uint32_t p = pass_of(unit);
   if (p >= open_passes_) return false;
-  return !program_.passes[p].tile_state || done_[unit_begin_[p - 1] + (unit - unit_begin_[p])];
+  return !program_.passes[p].tile_state || done_[unit_begin_[state_pass(p)] + (unit - unit_begin_[p])];
+}
+
+uint32_t PassSequencer::state_pass(uint32_t pass) const {
+  uint32_t q = pass;
+  while (q > 0 && program_.passes[--q].kind != UnitKind::Tile) {
+  }
+  return q;
 }
 
 uint32_t PassSequencer::spp_complete() const {

@@ -5,6 +5,7 @@
 #include "tessera/sequence/guide_training.h"
 #include "tessera/sequence/local_driver.h"
 #include "tessera/sequence/path_program.h"
+#include "tessera/sequence/photon_program.h"
 
 #include <algorithm>
 #include <chrono>
@@ -48,6 +49,38 @@ class PathUnits final : public UnitRenderer {
   GuideTraining* guide_;
 };
 
+// sppm's and vcm's units (photon_program.h).
+class LightVertexUnits final : public UnitRenderer {
+ public:
+  LightVertexUnits(const Scene& scene, uint32_t seed) : scene_(scene), seed_(seed) {}
+  void render(const PassSequencer& sequencer, const UnitWork& work, UnitResult& result) override {
+    render_light_vertex_unit(scene_, work.uses ? sequencer.artifact(*work.uses) : nullptr, work, seed_, result);
+  }
+
+ private:
+  const Scene& scene_;
+  uint32_t seed_;
+};
+
+// What no technique but the path tracer has: a per-pixel noise estimate, guides, AOVs.
+void check_settings(const Scene& scene, const RenderSettings& settings) {
+  const IntegratorType type = scene.integrator.type;
+  if (settings.aovs && (is_bidirectional(type) || uses_light_vertex_passes(type)))
+    throw std::invalid_argument("AOVs and denoising need the path tracer (integrator path or volpath): the " +
+                                std::string(integrator_name(type)) +
+                                " integrator's image is not the mean of a pixel's own samples");
+  if (!uses_light_vertex_passes(type)) return;
+  const char* what = settings.target_error > 0 ? "a target error"
+                     : settings.adaptive        ? "adaptive sampling"
+                     : settings.guiding.value_or(false) ? "path guiding"
+                                                        : nullptr;
+  if (what)
+    throw std::invalid_argument(std::string("the ") + integrator_name(type) +
+                                " integrator's passes refine an estimate from the light of their own pass, which a "
+                                "pixel's samples do not show the noise of: " +
+                                what + " needs the path tracer (integrator path or volpath)");
+}
+
 }  // namespace
 
 Film render(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress, RenderStats* stats) {
@@ -56,14 +89,16 @@ Film render(const Scene& scene, const RenderSettings& settings, const ProgressCa
   PathProgramOptions options{uint32_t(settings.spp), settings.target_error, settings.adaptive, settings.adaptive_settings,
                              guide_plan(scene, settings.guiding, settings.guiding_settings),
                              traces_light_paths(scene.integrator)};
-  if (settings.aovs && is_bidirectional(scene.integrator.type))
-    throw std::invalid_argument("AOVs and denoising need the path tracer (integrator path or volpath): the " +
-                                std::string(scene.integrator.type == IntegratorType::Bdpt ? "bdpt" : "ptracer") +
-                                " integrator's light paths are not in a pixel's own samples");
-  PassSequencer sequencer = path_sequencer(options, SequenceFrame{film_window(scene.film), scene.film.width,
-                                                                  scene.film.height, settings.tile_size, settings.aovs});
+  check_settings(scene, settings);
+  const SequenceFrame frame{film_window(scene.film), scene.film.width, scene.film.height, settings.tile_size, settings.aovs};
+  const bool light_vertices = uses_light_vertex_passes(scene.integrator.type);
+  PassSequencer sequencer =
+      light_vertices ? light_vertex_sequencer(scene, options.spp, frame) : path_sequencer(options, frame);
   auto* training = dynamic_cast<GuideTraining*>(sequencer.builder());
-  PathUnits units(scene, settings.seed, settings.aovs, training);
+  std::unique_ptr<UnitRenderer> units_owned;
+  if (light_vertices) units_owned = std::make_unique<LightVertexUnits>(scene, settings.seed);
+  else units_owned = std::make_unique<PathUnits>(scene, settings.seed, settings.aovs, training);
+  UnitRenderer& units = *units_owned;
   RenderProgress prog;
   prog.num_passes = int(sequencer.num_passes());
   prog.tiles_total = int64_t(sequencer.num_units());
@@ -81,7 +116,7 @@ Film render(const Scene& scene, const RenderSettings& settings, const ProgressCa
   if (stats) {
     stats->counters = films.counters();
     stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    stats->spp_done = sequencer.stopped() ? sequencer.spp_complete() : uint32_t(settings.spp);
+    stats->spp_done = sequencer.stopped() ? sequencer.spp_complete() : sequencer.program().spp;
     if (training && training->latest()) {
       stats->guide_leaves = training->tree_leaves();
       stats->guide_bytes = training->tree_bytes();

@@ -27,10 +27,18 @@ namespace tessera {
 // VolPath is the path tracer that also tracks participating media; the loader turns it into Path
 // on a scene without media (the same image, minus the sampler dimensions media would consume).
 // Bdpt and Ptracer (bidirectional path tracing, light tracing: bdpt.h) trace surfaces only; a scene
-// with media asked for them is rendered by VolPath with a note.
-enum class IntegratorType { Path, VolPath, Direct, Bdpt, Ptracer };
-/// True for bdpt and ptracer.
-inline bool is_bidirectional(IntegratorType type) { return type == IntegratorType::Bdpt || type == IntegratorType::Ptracer; }
+// with media asked for them is rendered by VolPath with a note. Sppm (stochastic progressive photon
+// mapping: sppm.h) and Vcm (vertex connection and merging: vcm.h) too.
+enum class IntegratorType { Path, VolPath, Direct, Bdpt, Ptracer, Sppm, Vcm };
+/// True for bdpt, ptracer and vcm.
+inline bool is_bidirectional(IntegratorType type) {
+  return type == IntegratorType::Bdpt || type == IntegratorType::Ptracer || type == IntegratorType::Vcm;
+}
+/// True for the integrators whose passes refine a per-pixel estimate from photons or light
+/// vertices of their own pass (sppm, vcm): sequence/photon_program.h runs them.
+inline bool uses_light_vertex_passes(IntegratorType type) { return type == IntegratorType::Sppm || type == IntegratorType::Vcm; }
+/// "path", "volpath", "direct", "bdpt", "ptracer", "sppm", "vcm": the name scenes and --integrator use.
+const char* integrator_name(IntegratorType type);
 // How path/volpath estimate direct light (integrator.h states each rule); Direct ignores it.
 enum class SamplingStrategy { Mis, Bsdf, Nee };
 
@@ -53,6 +61,20 @@ struct IntegratorSettings {
   // the render's); every other strategy adds nothing. s = -1: all of them, MIS-weighted.
   int only_s = -1, only_t = -1;
   bool only_weighted = false;
+  // sppm (Mitsuba 0.6's names, sppm.h): photons traced per pass; the gather radius of the first
+  // pass (0: automatic, 5 scene-sphere radii over the film's larger side as Mitsuba guesses it);
+  // the fraction of a pass's photons a pixel keeps (alpha); at most this many passes (-1: spp).
+  // vcm (vcm.h) reads initial_radius and alpha (its radius reduction) too.
+  uint64_t photon_count = 250000;
+  float initial_radius = 0.f;
+  float alpha = 0.7f;
+  int max_passes = -1;
+  // vcm: vertex merging and vertex connection (bdpt's strategies) on or off.
+  bool merge = true, connect = true;
+  // sppm, for tests and comparisons (never read from files): direct light at visible points from
+  // photons too (photons of every length stored), as Mitsuba 0.6's sppm does, instead of
+  // next-event estimation.
+  bool photon_direct = false;
   // How next-event estimation picks a light (render/light_sampler.h); read by Scene::finalize.
   LightSelection light_selection = LightSelection::Bvh;
   SamplingStrategy strategy = SamplingStrategy::Mis;  // path/volpath only; not read from scene files

@@ -61,16 +61,27 @@ struct PassSpec {
   /// The artifact iteration its units' records go into, if any: made at the barrier of the first
   /// pass that uses it, from the iteration before and every record of the passes that feed it.
   std::optional<uint32_t> feeds = std::nullopt;
-  /// (Tile) Unit (p, t) starts from the per-pixel state unit (p-1, t) of the same tile left (a
-  /// photon mapper's radii and counts): it is ready once that unit is done, without a barrier.
+  /// (Tile) Unit (p, t) starts from the per-pixel state that unit t of the latest Tile pass before
+  /// it left (a photon mapper's radii and counts): it is ready once that unit is done.
   bool tile_state = false;
-  /// (Paths) Traces the light subpaths of the pixel samples of the Tile pass just before it (the
-  /// same sample_begin and samples; path k is sample k / window pixels of window pixel k mod window
+  /// (Paths) Traces the light subpaths of the pixel samples of the Tile pass just before it, or
+  /// just after it (vcm's light vertices, which that pass merges with) (the same sample_begin and
+  /// samples; path k is sample k / window pixels of window pixel k mod window
   /// pixels, row-major): a bidirectional method's light tracing. It takes no sample indices of its
   /// own, so the passes' samples still add up to spp.
   bool same_samples = false;
+  /// (Paths) > 0: a photon pass of this many photons, numbered from 0 within the pass (a photon
+  /// mapper's, sequence/photon_program.h). It takes no sample indices of its own: sample_begin
+  /// names the pass (the sample index of the Tile pass that gathers its photons), samples is 0.
+  uint64_t photons = 0;
   bool operator==(const PassSpec&) const = default;
 };
+
+/// The paths a Paths pass traces: its photons, or `samples` per pixel of a window of
+/// `window_pixels`.
+inline uint64_t pass_paths(const PassSpec& pass, uint64_t window_pixels) {
+  return pass.photons > 0 ? pass.photons : window_pixels * pass.samples;
+}
 
 struct PassProgram {
   std::vector<PassSpec> passes;

@@ -21,8 +21,8 @@
 // - Artifacts. Built by the program's ArtifactBuilder at the barrier (iteration 0 at the start),
 //   from the records of the units that feed them; take_artifact() hands each new one out once,
 //   for the caller to store and, on the farm, to hash and name in the leases that render with it.
-// - State. A tile_state pass's unit (p, t) is ready only once unit (p-1, t) is done, and starts
-//   from the per-pixel state that result left (UnitResult::tile_state).
+// - State. A tile_state pass's unit (p, t) is ready only once unit t of the latest Tile pass
+//   before p is done, and starts from the per-pixel state that result left (UnitResult::tile_state).
 // - Restarts (the farm): begin_rebuild() holds every pass shut while stored decisions, artifacts,
 //   checkpoints and results are restored; end_rebuild() then opens what they allow, so a decision
 //   taken before a restart is recognised rather than taken again.
@@ -66,7 +66,7 @@ struct UnitWork {
   std::optional<PassSamples> samples;
   uint64_t path_begin = 0, path_end = 0;  // Paths: its light paths
   std::optional<uint32_t> uses, feeds;    // artifact iterations (PassSpec)
-  const std::string* tile_state = nullptr;  // tile_state: what unit (pass-1, index) left
+  const std::string* tile_state = nullptr;  // tile_state: what that unit left (PassSpec::tile_state)
 };
 
 /// A unit's result.
@@ -107,7 +107,7 @@ class PassSequencer {
   // Progress through the program.
   /// Passes [0, open_passes()) have units that may be rendered.
   size_t open_passes() const { return open_passes_; }
-  /// Open, not done, and (tile_state) its predecessor done.
+  /// Open, not done, and (tile_state) the unit whose state it starts from done.
   bool ready(size_t unit) const;
   bool is_done(size_t unit) const { return done_[unit]; }
   size_t done_units() const { return done_units_; }
@@ -175,6 +175,8 @@ class PassSequencer {
 
  private:
   void advance();
+  /// The Tile pass a tile_state pass's units start from: the latest before it.
+  uint32_t state_pass(uint32_t pass) const;
   bool at_barrier_decided_before(uint32_t pass) const;
   bool open_barrier(uint32_t pass);
   void build_artifact(uint32_t iteration);
@@ -189,7 +191,7 @@ class PassSequencer {
   FilmAssembler films_;
   std::vector<uint8_t> done_;
   std::vector<uint32_t> pass_done_;  // per pass: units done
-  std::vector<std::string> tile_states_;  // per unit of a pass whose successor is tile_state
+  std::vector<std::string> tile_states_;  // per Tile unit (a later tile_state pass starts from it)
   size_t done_units_ = 0, open_passes_ = 0, complete_passes_ = 0;
   uint64_t total_samples_ = 0, done_samples_ = 0;
   bool stopped_ = false, rebuilding_ = false;

@@ -66,6 +66,11 @@ struct JobLimits {
 };
 
 nlohmann::json to_json(const JobSettings& s);
+/// Why a job of the sppm or vcm integrator (given or in its scene file) is refused.
+inline constexpr const char* kFarmRefusesLightVertexPasses =
+    "the farm does not run the sppm and vcm integrators yet (their passes make a photon or light vertex map "
+    "that the next units render with, and sppm's carry per-pixel state from pass to pass): render the scene "
+    "with `tessera render --integrator sppm` (or vcm), or submit it with another integrator";
 /// `j` must be an object; `require_scene` demands the `scene` field (not for multipart uploads).
 /// `out_of_range` (if given) tells a number outside its field's range (the API's 422) from a
 /// malformed request (400); the error names the field and the range.
