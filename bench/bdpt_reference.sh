@@ -55,25 +55,8 @@ render() {
 # means FILE: the image's channel means (tessera compare's mean=R,G,B).
 means() { "$tessera" compare "$1" "$shared_ref/reference.exr" | grep -o ' mean=[^ ]*' | cut -d= -f2; }
 
-# mean_and_variance OUT_MEAN OUT_VARIANCE FILE...: per pixel, the mean of the images and the
-# variance of that mean.
-mean_and_variance() {
-  local mean=$1 variance=$2 k
-  shift 2
-  k=$#
-  local sum=() sumsq=() first=1
-  for f in "$@"; do
-    sum+=("$f" --ch R,G,B)
-    sumsq+=("$f" --ch R,G,B --dup --mul)
-    [ $first = 1 ] || { sum+=(--add); sumsq+=(--add); }
-    first=0
-  done
-  oiiotool "${sum[@]}" -d float -o "$tmp/sum.exr"
-  oiiotool "${sumsq[@]}" -d float -o "$tmp/sumsq.exr"
-  oiiotool "$tmp/sum.exr" --divc "$k" -d float -o "$mean"
-  oiiotool "$tmp/sumsq.exr" "$tmp/sum.exr" --dup --mul --divc "$k" --sub --divc "$((k * (k - 1)))" \
-    --clamp:min=0 -d float -o "$variance"
-}
+# mean_and_variance TMP_DIR OUT_MEAN OUT_VARIANCE FILE... (bench/lib/image_stats.sh)
+source bench/lib/image_stats.sh
 
 if [ -z "${BR_SKIP_REFERENCE:-}" ]; then
   : > "$tmp/runs.csv"
@@ -84,7 +67,7 @@ if [ -z "${BR_SKIP_REFERENCE:-}" ]; then
     echo "$seed,$secs,$(means "$tmp/r$i.exr")" | tee -a "$tmp/runs.csv" >&2
     files+=("$tmp/r$i.exr")
   done
-  mean_and_variance "$dir/reference.exr" "$dir/variance.exr" "${files[@]}"
+  mean_and_variance "$tmp" "$dir/reference.exr" "$dir/variance.exr" "${files[@]}"
   cp "$tmp/runs.csv" "$dir/runs.csv"
 fi
 [ -f "$dir/runs.csv" ] || { echo "bdpt_reference.sh: no $dir/runs.csv: run without BR_SKIP_REFERENCE first" >&2; exit 1; }

@@ -83,25 +83,8 @@ render() {
   grep -o 'render [0-9.e+-]* s' "$tmp/log" | tail -1 | awk '{print $2}'
 }
 
-# mean_and_variance OUT_MEAN OUT_VARIANCE FILE...: per pixel, the mean of the images and the
-# variance of that mean (as bench/bdpt_reference.sh).
-mean_and_variance() {
-  local mean=$1 variance=$2 k
-  shift 2
-  k=$#
-  local sum=() sumsq=() first=1
-  for f in "$@"; do
-    sum+=("$f" --ch "R,G,B")
-    sumsq+=("$f" --ch "R,G,B" --dup --mul)
-    [ $first = 1 ] || { sum+=(--add); sumsq+=(--add); }
-    first=0
-  done
-  oiiotool "${sum[@]}" -d float -o "$tmp/sum.exr"
-  oiiotool "${sumsq[@]}" -d float -o "$tmp/sumsq.exr"
-  oiiotool "$tmp/sum.exr" --divc "$k" -d float -o "$mean"
-  oiiotool "$tmp/sumsq.exr" "$tmp/sum.exr" --dup --mul --divc "$k" --sub --divc "$((k * (k - 1)))" \
-    --clamp:min=0 -d float -o "$variance"
-}
+# mean_and_variance TMP_DIR OUT_MEAN OUT_VARIANCE FILE... (bench/lib/image_stats.sh)
+source bench/lib/image_stats.sh
 
 # method LABEL INTEGRATOR SPP FIRST_SEED: the renders, their mean and variance in OUT/SCENE/LABEL,
 # and $tmp/LABEL.csv (seed, seconds, PFM file) for the analysis.
@@ -115,7 +98,7 @@ method() {
     echo "$seed,$secs,$tmp/$label$i.pfm" >> "$tmp/$label.csv"
     files+=("$tmp/$label$i.exr")
   done
-  mean_and_variance "$dir/$label/reference.exr" "$dir/$label/variance.exr" "${files[@]}"
+  mean_and_variance "$tmp" "$dir/$label/reference.exr" "$dir/$label/variance.exr" "${files[@]}"
 }
 
 method A "$method_a" "$spp_a" 1001

@@ -15,16 +15,9 @@
 namespace tessera {
 namespace {
 
-using test::scene_error_of;
+using namespace tessera::test;
 
-using test::count_messages;
-
-const std::string kPerspective = test::kPerspectiveSensor;
-
-LoadResult load(const std::string& integrator, const std::string& rest = kPerspective,
-                const std::string& version = "0.6.0", LoadOptions opt = {}) {
-  return test::load_integrator("mem/bidir.xml", integrator, rest, version, opt);
-}
+const IntegratorLoader load{"mem/bidir.xml"};
 
 TEST(BidirectionalLoader, BdptMapsMitsuba06Parameters) {
   LoadResult r = load(R"(<integrator type="bdpt">

@@ -10,17 +10,20 @@
 
 namespace tessera::test {
 
-inline const char* kPerspectiveSensor = R"(<sensor type="perspective"><float name="fov" value="40"/>
+inline const char* kPerspective = R"(<sensor type="perspective"><float name="fov" value="40"/>
   <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film></sensor>
 )";
 
-inline LoadResult load_integrator(const std::string& file, const std::string& integrator,
-                                  const std::string& rest = kPerspectiveSensor, const std::string& version = "0.6.0",
-                                  const LoadOptions& opt = {}) {
-  const std::string xml = "<scene version=\"" + version + "\">\n" + integrator + "\n" + rest +
-                          "<shape type=\"sphere\"/>\n</scene>\n";
-  return load_scene(parse_scene_string(xml, file), opt);
-}
+/// load(integrator, rest, version, options): the scene of file name `file` (messages name it).
+struct IntegratorLoader {
+  std::string file;
+  LoadResult operator()(const std::string& integrator, const std::string& rest = kPerspective,
+                        const std::string& version = "0.6.0", const LoadOptions& opt = {}) const {
+    const std::string xml = "<scene version=\"" + version + "\">\n" + integrator + "\n" + rest +
+                            "<shape type=\"sphere\"/>\n</scene>\n";
+    return load_scene(parse_scene_string(xml, file), opt);
+  }
+};
 
 inline size_t count_messages(const LoadResult& r, LoadMessage::Level level, const std::string& text) {
   size_t n = 0;

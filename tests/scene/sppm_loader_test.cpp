@@ -16,16 +16,9 @@
 namespace tessera {
 namespace {
 
-using test::scene_error_of;
+using namespace tessera::test;
 
-using test::count_messages;
-
-const std::string kPerspective = test::kPerspectiveSensor;
-
-LoadResult load(const std::string& integrator, const std::string& rest = kPerspective,
-                const std::string& version = "0.6.0", LoadOptions opt = {}) {
-  return test::load_integrator("mem/sppm.xml", integrator, rest, version, opt);
-}
+const IntegratorLoader load{"mem/sppm.xml"};
 
 TEST(SppmLoader, MapsMitsuba06Parameters) {
   LoadResult r = load(R"(<integrator type="sppm">

@@ -3,7 +3,6 @@
 #include "render/bdpt_subpath.h"
 #include "render/bounce_samples.h"
 #include "render/octahedral.h"
-#include "tessera/render/sppm.h"
 #include "tessera/render/vcm.h"
 
 #include <algorithm>
@@ -304,7 +303,12 @@ std::unique_ptr<Integrator> make_bdpt_integrator(const IntegratorSettings& setti
 }
 
 float vcm_radius(const Scene& scene, uint32_t iteration) {
-  return sppm_initial_radius(scene) / std::pow(float(iteration) + 1.f, 0.5f * (1.f - scene.integrator.alpha));
+  float r0 = scene.integrator.initial_radius;
+  if (!(r0 > 0.f)) {
+    const Bounds3 b = scene.bounds();
+    r0 = 0.003f * (b.empty() ? 1.f : std::max(0.5f * length(b.diagonal()), 1e-4f));  // (SmallVCM's)
+  }
+  return r0 / std::pow(float(iteration) + 1.f, 0.5f * (1.f - scene.integrator.alpha));
 }
 
 std::unique_ptr<Integrator> make_vcm_integrator(const IntegratorSettings& settings, const VcmIteration& it) {
