@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 
 namespace tessera {
@@ -64,12 +65,17 @@ JobPlan make_job_plan(const std::string& bundle_dir, const std::string& scene_fi
       throw SceneError(FileLoc{scene_file, 0}, "the scene references '" + f + "', which is outside its bundle");
     if (std::find(plan.files.begin(), plan.files.end(), rel) == plan.files.end()) plan.files.push_back(rel);
   }
-  if (uses_light_vertex_passes(s.integrator.type)) throw std::invalid_argument(kFarmRefusesLightVertexPasses);
+  if (std::string e = technique_settings_error(s.integrator.type, settings.sums_aovs(), settings.target_error,
+                                               settings.adaptive, settings.guiding.value_or(false));
+      !e.empty())
+    throw std::invalid_argument(e);
+  if (uses_light_vertex_passes(s.integrator.type)) {
+    plan.points = point_map_plan(s);
+    plan.program = light_vertex_program(s, uint32_t(plan.settings.spp), uint64_t(plan.window.area()));
+    return plan;
+  }
   PathProgramOptions options = path_options(plan);
   options.light_paths = traces_light_paths(s.integrator);
-  if (is_bidirectional(s.integrator.type) && settings.sums_aovs())
-    throw std::invalid_argument("AOVs and denoising need the path tracer (integrator path or volpath): this "
-                                "integrator's light paths are not in a pixel's own samples");
   plan.program = path_program(options);
   return plan;
 }
@@ -144,7 +150,82 @@ SplatResult render_paths_lease(const Scene& scene, const Lease& lease) {
 
 namespace {
 
+// The unit a lease of a light-vertex job names, as the sequencer gave it to the coordinator.
+UnitWork lease_work(const Lease& lease) {
+  UnitWork w;
+  w.pass = lease.pass;
+  w.index = lease.tile;
+  w.kind = lease.paths ? UnitKind::Paths : UnitKind::Tile;
+  w.rect = lease.rect;
+  w.sample_begin = lease.sample_begin;
+  w.sample_end = lease.sample_end;
+  if (lease.paths) {
+    w.path_begin = lease.paths->first;
+    w.path_end = lease.paths->second;
+    w.feeds = lease.sample_begin;  // (every light pass of a program with maps feeds one)
+  }
+  if (lease.guide) w.uses = lease.guide->iteration;
+  if (!lease.tile_state.empty()) w.tile_state = &lease.tile_state;
+  return w;
+}
+
+}  // namespace
+
+TileResult render_light_vertex_tile(const Scene& scene, const Lease& lease, const Artifact* points) {
+  if (lease.paths || !uses_light_vertex_passes(scene.integrator.type))
+    throw std::invalid_argument("render_light_vertex_tile: not a tile of an sppm or vcm job");
+  if (lease.guide && !points) throw std::invalid_argument("render_light_vertex_tile: a lease without its map");
+  const auto t0 = std::chrono::steady_clock::now();
+  UnitResult unit;
+  unit.tile.reset(lease.rect);
+  render_light_vertex_unit(scene, points, lease_work(lease), lease.settings.seed, unit);
+  TileResult r;
+  begin_tile_result(lease, r);
+  r.film = std::move(unit.tile);
+  r.tile_state = std::move(unit.tile_state);
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
+
+SplatResult render_light_vertex_paths(const Scene& scene, const Lease& lease) {
+  if (!lease.paths || !uses_light_vertex_passes(scene.integrator.type))
+    throw std::invalid_argument("render_light_vertex_paths: not a lease of light paths of an sppm or vcm job");
+  const auto t0 = std::chrono::steady_clock::now();
+  UnitResult unit;
+  UnitWork work = lease_work(lease);
+  if (!point_map_plan(scene)) work.feeds.reset();  // (vcm without merging: bdpt's light paths)
+  render_light_vertex_unit(scene, nullptr, work, lease.settings.seed, unit);
+  SplatResult r;
+  r.job_id = lease.job_id;
+  r.pass = lease.pass;
+  r.unit = lease.tile;
+  r.path_begin = work.path_begin;
+  r.path_end = work.path_end;
+  r.splats = std::move(unit.splats);
+  r.records = std::move(unit.records);
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
+
+namespace {
+
 using nlohmann::json;
+
+json points_json(const PointMapPlan& p) {
+  return {{"integrator", integrator_name(p.type)}, {"initial_radius", p.initial_radius}, {"alpha", p.alpha}};
+}
+
+PointMapPlan points_from_json(const json& j) {
+  PointMapPlan p;
+  const std::string type = j.at("integrator").get<std::string>();
+  if (type != "sppm" && type != "vcm") throw std::invalid_argument("points: integrator '" + type + "'");
+  p.type = type == "sppm" ? IntegratorType::Sppm : IntegratorType::Vcm;
+  p.initial_radius = j.at("initial_radius").get<float>();
+  p.alpha = j.at("alpha").get<float>();
+  if (!(p.initial_radius > 0.f) || !std::isfinite(p.initial_radius) || !(p.alpha > 0.f && p.alpha <= 1.f))
+    throw std::invalid_argument("points: radius or alpha out of range");
+  return p;
+}
 
 json guide_json(const JobPlan::Guide& g) {
   const GuidingSettings& s = g.settings;
@@ -190,6 +271,7 @@ nlohmann::json to_json(const JobPlan& p) {
           {"gamma", p.gamma},
           {"exposure", p.exposure},
           {"guide", p.guide ? guide_json(*p.guide) : json(nullptr)},
+          {"points", p.points ? points_json(*p.points) : json(nullptr)},
           {"program", to_json(p.program)}};
 }
 
@@ -208,6 +290,8 @@ bool job_plan_from_json(const nlohmann::json& j, JobPlan& out, std::string& erro
     out.exposure = j.at("exposure").get<float>();
     out.guide.reset();
     if (j.contains("guide") && !j["guide"].is_null()) out.guide = guide_from_json(j["guide"]);
+    out.points.reset();
+    if (j.contains("points") && !j["points"].is_null()) out.points = points_from_json(j["points"]);
     // (A plan stored before programs were kept has none: its settings give it, job_program().)
     out.program = PassProgram{};
     if (j.contains("program") && !program_from_json(j["program"], out.program, error)) return false;

@@ -176,9 +176,9 @@ bool check_job_limits(const JobSettings& s, const JobLimits& l, std::string& err
   }
   // The names LoadOptions::integrator takes; checked here so that a typo is refused before a bundle is read.
   const std::string& i = s.integrator;
-  if (i == "sppm" || i == "vcm") return fail(kFarmRefusesLightVertexPasses);
-  if (!i.empty() && i != "path" && i != "volpath" && i != "direct" && i != "bdpt" && i != "ptracer")
-    return fail("integrator '" + i + "' is not path, volpath, direct, bdpt or ptracer");
+  if (!i.empty() && i != "path" && i != "volpath" && i != "direct" && i != "bdpt" && i != "ptracer" && i != "sppm" &&
+      i != "vcm")
+    return fail("integrator '" + i + "' is not path, volpath, direct, bdpt, ptracer, sppm or vcm");
   if (!s.light_selection.empty() && s.light_selection != "power" && s.light_selection != "bvh")
     return fail("light_selection '" + s.light_selection + "' is not power or bvh");
   return true;

@@ -1,5 +1,7 @@
 #include "tessera/farm/program_json.h"
 
+#include "tessera/render/sppm.h"
+
 namespace tessera {
 
 using nlohmann::json;
@@ -7,7 +9,7 @@ using nlohmann::json;
 namespace {
 
 json pass_json(const PassSpec& p) {
-  return {{"kind", unit_kind_name(p.kind)},
+  json j = {{"kind", unit_kind_name(p.kind)},
           {"sample_begin", p.sample_begin},
           {"samples", p.samples},
           {"barrier", p.barrier},
@@ -18,6 +20,8 @@ json pass_json(const PassSpec& p) {
           {"feeds", p.feeds ? json(*p.feeds) : json(nullptr)},
           {"tile_state", p.tile_state},
           {"same_samples", p.same_samples}};
+  if (p.photons > 0) j["photons"] = p.photons;  // (a photon pass's)
+  return j;
 }
 
 std::optional<uint32_t> optional_u32(const json& j) {
@@ -26,9 +30,9 @@ std::optional<uint32_t> optional_u32(const json& j) {
 }
 
 PassSpec pass_from_json(const json& j) {
-  // (Plans stored before same_samples existed have the other ten.)
-  const bool has_same = j.contains("same_samples");
-  if (j.size() != (has_same ? 11u : 10u)) throw std::invalid_argument("a pass has exactly its eleven fields");
+  // (Plans stored before same_samples existed have the other ten; only a photon pass has photons.)
+  const bool has_same = j.contains("same_samples"), has_photons = j.contains("photons");
+  if (j.size() != 10u + has_same + has_photons) throw std::invalid_argument("a pass has exactly its eleven fields");
   PassSpec p;
   const std::string kind = j.at("kind").get<std::string>();
   if (kind != "tile" && kind != "paths") throw std::invalid_argument("pass kind '" + kind + "'");
@@ -43,6 +47,9 @@ PassSpec pass_from_json(const json& j) {
   p.feeds = optional_u32(j.at("feeds"));
   p.tile_state = j.at("tile_state").get<bool>();
   p.same_samples = has_same && j.at("same_samples").get<bool>();
+  if (has_photons) p.photons = j.at("photons").get<uint64_t>();
+  if (has_photons && (p.photons == 0 || p.photons > kMaxPhotonsPerPass || p.kind != UnitKind::Paths))
+    throw std::invalid_argument("a photon pass has 1 to " + std::to_string(kMaxPhotonsPerPass) + " photons");
   return p;
 }
 

@@ -3,6 +3,9 @@
 #include "json_fields.h"
 #include "tessera/farm/sha256.h"
 
+#include <openssl/evp.h>
+
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <stdexcept>
@@ -13,6 +16,28 @@ using nlohmann::json;
 using json_fields::Fields;
 
 namespace {
+
+size_t base64_size(size_t bytes) { return 4 * ((bytes + 2) / 3); }
+
+std::string to_base64(std::string_view bytes) {
+  std::string out(base64_size(bytes.size()), '\0');
+  const int n = EVP_EncodeBlock(reinterpret_cast<unsigned char*>(out.data()),
+                                reinterpret_cast<const unsigned char*>(bytes.data()), int(bytes.size()));
+  out.resize(size_t(std::max(n, 0)));
+  return out;
+}
+
+bool from_base64(std::string_view text, std::string& out) {
+  if (text.size() % 4 != 0) return false;
+  out.assign(text.size() / 4 * 3, '\0');
+  const int n = EVP_DecodeBlock(reinterpret_cast<unsigned char*>(out.data()),
+                                reinterpret_cast<const unsigned char*>(text.data()), int(text.size()));
+  if (n < 0) return false;
+  // (EVP_DecodeBlock keeps the padding's zero bytes.)
+  const size_t pad = text.empty() ? 0 : size_t(text.back() == '=') + size_t(text.size() > 1 && text[text.size() - 2] == '=');
+  out.resize(size_t(n) - pad);
+  return true;
+}
 
 // A lease's fields split in two: its own, and its job's (the same in every lease of the job).
 json lease_own_json(const Lease& l) {
@@ -30,6 +55,13 @@ json lease_own_json(const Lease& l) {
   }
   if (l.guide) j["guide"] = {{"hash", l.guide->hash}, {"iteration", l.guide->iteration}, {"train", l.guide->train}};
   if (l.paths) j["paths"] = {l.paths->first, l.paths->second};
+  return j;
+}
+
+// Its own fields with the tile state (base64 of up to megabytes: left out where only sizes count).
+json lease_own_json_with_state(const Lease& l) {
+  json j = lease_own_json(l);
+  if (!l.tile_state.empty()) j["tile_state"] = to_base64(l.tile_state);
   return j;
 }
 
@@ -56,7 +88,7 @@ json lease_job_json(const Lease& l) {
 }  // namespace
 
 json to_json(const Lease& l) {
-  json j = lease_own_json(l);
+  json j = lease_own_json_with_state(l);
   j.update(lease_job_json(l));
   return j;
 }
@@ -66,7 +98,8 @@ size_t lease_job_part_bytes(const Lease& l) { return lease_job_json(l).dump().si
 size_t lease_json_bytes(const Lease& l, size_t job_part_bytes) {
   // "{own}" and "{job}" make "{own,job}": one byte fewer than the two apart (the order of the
   // keys does not change the length).
-  return lease_own_json(l).dump().size() + job_part_bytes - 1;
+  const size_t state = l.tile_state.empty() ? 0 : std::string_view(R"(,"tile_state":"")").size() + base64_size(l.tile_state.size());
+  return lease_own_json(l).dump().size() + state + job_part_bytes - 1;
 }
 
 bool lease_from_json(const json& j, Lease& out, std::string& error) {
@@ -85,6 +118,8 @@ bool lease_from_json(const json& j, Lease& out, std::string& error) {
   f.get("seconds_to_expiry", out.seconds_to_expiry);
   json guide;
   f.get("guide", guide);
+  std::string state;
+  f.get("tile_state", state);
   std::vector<uint64_t> paths;
   f.get("paths", paths);
   f.get("settings", settings, true);
@@ -97,8 +132,14 @@ bool lease_from_json(const json& j, Lease& out, std::string& error) {
     return false;
   }
   out.rect = {rect[0], rect[1], rect[2], rect[3]};
-  if (out.rect.empty() || out.sample_end <= out.sample_begin) {
+  // (A photon pass's lease of paths names its pass by sample_begin and has no samples.)
+  if (out.rect.empty() || out.sample_end < out.sample_begin || (out.sample_end == out.sample_begin && paths.empty())) {
     error = "lease: empty rectangle or sample range";
+    return false;
+  }
+  out.tile_state.clear();
+  if (state.size() > base64_size(kMaxLeaseStateBytes) || !from_base64(state, out.tile_state) || (!state.empty() && !paths.empty())) {
+    error = "lease: 'tile_state' must be base64 of at most " + std::to_string(kMaxLeaseStateBytes) + " bytes, on a lease of a tile";
     return false;
   }
   out.samples.rect = out.rect;

@@ -19,11 +19,12 @@ using result_bytes::Reader;
 
 static_assert(std::endian::native == std::endian::little, "the tile format is little-endian");
 constexpr char kMagic[4] = {'T', 'S', 'T', 'R'};
-// Version 4 adds the AOV sums; version 3 training records; version 2 ends in an XXH3-128 checksum;
-// version 1 (results and checkpoints stored by earlier versions) in a SHA-256. The checksum guards
-// against corruption in transit and on disk, not against an adversary (tokens do that), and SHA-256
-// was a tenth of the coordinator's time per unit.
-constexpr uint32_t kVersion = 4;
+// Version 5 adds the per-pixel state; version 4 the AOV sums; version 3 training records; version 2
+// ends in an XXH3-128 checksum; version 1 (results and checkpoints stored by earlier versions) in a
+// SHA-256. The checksum guards against corruption in transit and on disk, not against an adversary
+// (tokens do that), and SHA-256 was a tenth of the coordinator's time per unit.
+constexpr uint32_t kVersion = 5;
+constexpr uint32_t kVersionNoState = 4;
 constexpr uint32_t kVersionNoAovs = 3;
 constexpr uint32_t kVersionNoTraining = 2;
 constexpr uint32_t kVersionSha256 = 1;
@@ -40,9 +41,9 @@ size_t digest_bytes(uint32_t version) { return version == kVersionSha256 ? sizeo
 
 }  // namespace
 
-uint64_t max_tile_result_bytes(const TileRect& rect, bool aovs, bool training) {
-  const uint64_t raw = kHeaderBytes + uint64_t(rect.area()) * (kPixelBytes + (aovs ? kAovBytes : 0)) + 16 +
-                       (training ? kMaxTrainingBytes : 0) + kMaxDigestBytes;
+uint64_t max_tile_result_bytes(const TileRect& rect, bool aovs, bool training, bool state) {
+  const uint64_t per_pixel = kPixelBytes + (aovs ? kAovBytes : 0) + (state ? kMaxStateBytesPerPixel : 0);
+  const uint64_t raw = kHeaderBytes + uint64_t(rect.area()) * per_pixel + 24 + (training ? kMaxTrainingBytes : 0) + kMaxDigestBytes;
   return result_bytes::max_compressed_bytes(raw);
 }
 
@@ -66,6 +67,8 @@ std::string encode_tile_result(const TileResult& r, int level) {
   raw.append(r.training);
   put(raw, uint64_t(r.film.aovs().size()));
   raw.append(reinterpret_cast<const char*>(r.film.aovs().data()), r.film.aovs().size() * kAovBytes);
+  put(raw, uint64_t(r.tile_state.size()));
+  raw.append(r.tile_state);
   const auto digest = checksum(raw);
   raw.append(digest.data(), digest.size());
   return result_bytes::compress(std::move(raw), level);
@@ -75,8 +78,8 @@ namespace {
 
 // The uncompressed bytes of a compressed result, into `raw`, within what `max_pixels` allows.
 bool decompress(std::string_view bytes, std::string& raw, std::string& error, int64_t max_pixels) {
-  const uint64_t max_size =
-      kHeaderBytes + kMaxDigestBytes + uint64_t(max_pixels) * (kPixelBytes + kAovBytes) + 16 + kMaxTrainingBytes;
+  const uint64_t max_size = kHeaderBytes + kMaxDigestBytes +
+                            uint64_t(max_pixels) * (kPixelBytes + kAovBytes + kMaxStateBytesPerPixel) + 24 + kMaxTrainingBytes;
   return result_bytes::decompress(bytes, max_size, raw, error, "tile result");
 }
 
@@ -87,6 +90,38 @@ bool checksum_matches(std::string_view raw, uint32_t version) {
   const std::string_view body = raw.substr(0, raw.size() - n), stored = raw.substr(raw.size() - n);
   if (version == kVersionSha256) return std::memcmp(sha256(body).data(), stored.data(), n) == 0;
   return std::memcmp(checksum(body).data(), stored.data(), n) == 0;
+}
+
+// Where the sections after the pixel sums lie (each a u64 count and its bytes): training records
+// (version 3 on), AOV sums (4 on: none, or one per pixel), per-pixel state (5 on: at most
+// kMaxStateBytesPerPixel a pixel). `fit`: they end exactly at `body`, each within its bound.
+struct Sections {
+  uint64_t training = 0, aov_pixels = 0, state = 0;
+  size_t training_at = 0, aovs_at = 0, state_at = 0;
+  bool fit = false;
+};
+
+Sections sections(std::string_view raw, uint32_t version, size_t pixel_end, size_t body, uint64_t pixels) {
+  Sections s;
+  size_t at = pixel_end;
+  // A section's count, or false when it does not fit before `body` or exceeds `max` units.
+  auto count = [&](uint32_t since, uint64_t& n, uint64_t max, size_t unit, size_t& data_at) {
+    if (version < since) {
+      data_at = at;
+      return true;
+    }
+    if (body < at + 8) return false;
+    std::memcpy(&n, raw.data() + at, 8);
+    if (n > max || body - (at + 8) < n * unit) return false;
+    data_at = at + 8;
+    at = data_at + size_t(n * unit);
+    return true;
+  };
+  s.fit = count(kVersionNoAovs, s.training, kMaxTrainingBytes, 1, s.training_at) &&
+          count(kVersionNoState, s.aov_pixels, pixels, kAovBytes, s.aovs_at) &&
+          count(kVersion, s.state, pixels * kMaxStateBytesPerPixel, 1, s.state_at) &&
+          (s.aov_pixels == 0 || s.aov_pixels == pixels) && at == body;
+  return s;
 }
 
 }  // namespace
@@ -115,7 +150,8 @@ bool decode_tile_result(std::string_view bytes, TileResult& out, std::string& er
   }
   rd.pos = 4;
   const uint32_t version = rd.get<uint32_t>();
-  if (version != kVersion && version != kVersionNoAovs && version != kVersionNoTraining && version != kVersionSha256) {
+  if (version != kVersion && version != kVersionNoState && version != kVersionNoAovs && version != kVersionNoTraining &&
+      version != kVersionSha256) {
     error = "tile result: format version " + std::to_string(version) + ", expected " + std::to_string(kVersion);
     return false;
   }
@@ -137,30 +173,22 @@ bool decode_tile_result(std::string_view bytes, TileResult& out, std::string& er
   }
   const size_t pixel_end = kHeaderBytes + size_t(rect.area()) * kPixelBytes;
   const size_t body = raw.size() - digest_bytes(version);
-  // Version 3 on: u64 training bytes and the records; version 4 on: u64 AOV pixels and their sums.
-  uint64_t training = 0, aov_pixels = 0;
-  if (version >= kVersionNoAovs && body >= pixel_end + 8) std::memcpy(&training, raw.data() + pixel_end, 8);
-  training = std::min<uint64_t>(training, kMaxTrainingBytes + 1);
-  const size_t aov_at = pixel_end + 8 + size_t(training);
-  if (version >= kVersion && body >= aov_at + 8) std::memcpy(&aov_pixels, raw.data() + aov_at, 8);
-  const bool aovs_fit = aov_pixels == 0 || aov_pixels == uint64_t(rect.area());
-  const size_t extra = version < kVersionNoAovs ? 0
-                       : version == kVersionNoAovs ? 8 + size_t(training)
-                                                    : 16 + size_t(training) + (aovs_fit ? size_t(aov_pixels) * kAovBytes : 0);
-  if (rect.empty() || rect.x0 < 0 || rect.y0 < 0 || training > kMaxTrainingBytes || !aovs_fit ||
-      body != pixel_end + extra) {
+  const Sections sec = sections(raw, version, pixel_end, body, uint64_t(rect.area()));
+  if (rect.empty() || rect.x0 < 0 || rect.y0 < 0 || !sec.fit) {
     error = "tile result: pixel data does not match the tile's rectangle";
     return false;
   }
   out.sample_begin = rd.get<uint32_t>();
   out.sample_end = rd.get<uint32_t>();
-  out.film.reset(rect, aov_pixels > 0);
+  out.film.reset(rect, sec.aov_pixels > 0);
   RenderCounters& c = out.film.counters;
   for (uint64_t* v : {&c.samples, &c.camera_rays, &c.bounce_rays, &c.shadow_rays, &c.nonfinite}) *v = rd.get<uint64_t>();
   out.seconds = rd.get<double>();
   std::memcpy(out.film.mutable_pixels().data(), raw.data() + rd.pos, out.film.pixels().size() * kPixelBytes);
-  out.training.assign(raw.data() + pixel_end + (extra ? 8 : 0), size_t(training));
-  if (aov_pixels > 0) std::memcpy(out.film.mutable_aovs().data(), raw.data() + aov_at + 8, size_t(aov_pixels) * kAovBytes);
+  out.training.assign(raw.data() + sec.training_at, size_t(sec.training));
+  if (sec.aov_pixels > 0)
+    std::memcpy(out.film.mutable_aovs().data(), raw.data() + sec.aovs_at, size_t(sec.aov_pixels) * kAovBytes);
+  out.tile_state.assign(raw.data() + sec.state_at, size_t(sec.state));
   return true;
 }
 

@@ -112,6 +112,8 @@ struct Coordinator::Impl {
   void reap_loop() TESSERA_EXCLUDES(mu);
 
   // Results (coordinator_results.cpp).
+  /// Whether an upload's records are valid records of its job's point map (none: nothing to check).
+  Status check_point_records(const UnitUpload& upload) TESSERA_EXCLUDES(mu);
   /// The unit an uploaded result is for, once worker, job and unit (and the result's kind) check out.
   Result<size_t> check_result(uint64_t worker, const UnitUpload& upload) TESSERA_REQUIRES(mu);
   Status check_tile_result(const JobState& job, size_t unit, const TileResult& result);

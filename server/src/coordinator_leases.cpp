@@ -89,6 +89,7 @@ Coordinator::Impl::IssuedLease Coordinator::Impl::issue_lease(uint64_t worker, W
   if (std::optional<PassSamples> samples = job.lease_samples(unit)) l.samples = std::move(*samples);
   if (!job.is_tile_unit(unit)) l.paths = job.paths(unit);
   l.guide = job.lease_guide(unit);
+  if (const std::string* state = job.lease_tile_state(unit)) l.tile_state = *state;
   l.seconds_to_expiry = opt.heartbeat_interval * kMissedHeartbeats;
   l.settings = job.plan().settings;
   l.scene_file = job.plan().scene_file;

@@ -40,12 +40,33 @@ Status Coordinator::Impl::check_tile_result(const JobState& job, size_t unit, co
   if (!job.result_fits(unit, result.film))
     return make_error(Code::BadRequest, "bad_result",
                       "the result's per-pixel sample counts are not those its adaptive pass gives the tile");
+  if (job.tile_leaves_state(unit)) {
+    std::string error;
+    if (!check_sppm_state(result.tile_state, size_t(result.film.rect().area()), error))
+      return make_error(Code::BadRequest, "bad_result", "the result's " + error);
+  } else if (!result.tile_state.empty()) {
+    return make_error(Code::BadRequest, "bad_result", "the result carries per-pixel state the job's passes do not use");
+  }
   return Status::success();
 }
 
 Status Coordinator::Impl::check_splat_result(const JobState& job, size_t unit, const SplatResult& result) {
   if (!(result.splats.window == job.plan().window) || std::pair{result.path_begin, result.path_end} != job.paths(unit))
     return make_error(Code::BadRequest, "bad_result", "the result's window or light paths do not match the unit");
+  return Status::success();
+}
+
+Status Coordinator::Impl::check_point_records(const UnitUpload& upload) {
+  if (upload.records().empty()) return Status::success();
+  std::optional<IntegratorType> type;
+  {
+    MutexLock lock(mu);
+    if (const JobState* job = jobs.find(upload.job())) type = job->point_records();
+  }
+  // (Every record's values: megabytes of them, checked off the lock; check_result checks the rest.)
+  std::string error;
+  if (type && !tessera::check_point_records(*type, upload.records(), error))
+    return make_error(Code::BadRequest, "bad_result", error);
   return Status::success();
 }
 
@@ -84,7 +105,8 @@ void Coordinator::Impl::result_committed(bool durable, uint64_t job_id, size_t u
     return;
   }
   const uint64_t samples = job.unit_samples(unit);
-  const bool added = upload.tile ? job.add_result(unit, std::move(upload.tile->film), worker, upload.records())
+  const bool added = upload.tile ? job.add_result(unit, std::move(upload.tile->film), worker, upload.records(),
+                                                  std::move(upload.tile->tile_state))
                                  : job.add_splats(unit, std::move(upload.splats->splats), worker, upload.records());
   if (!added) return;  // (a retry rebuilt it meanwhile)
   job.unit_times.add(upload.seconds());
@@ -111,7 +133,8 @@ uint64_t Coordinator::Impl::commit_result(JobState& job, size_t unit, uint64_t w
   // own bytes never stored). Otherwise stored as it came, and folded in later.
   std::shared_ptr<JobState::Checkpoint> cp;
   if (upload.tile)
-    if (auto with = job.checkpoint_with(unit, upload.tile->film)) cp = std::make_shared<JobState::Checkpoint>(std::move(*with));
+    if (auto with = job.checkpoint_with(unit, upload.tile->film, upload.tile->tile_state))
+      cp = std::make_shared<JobState::Checkpoint>(std::move(*with));
   job.start_commit(unit);
   // Another copy is still being rendered (speculative, or re-issued from a worker thought dead):
   // its result will be checked against this one.
@@ -123,7 +146,7 @@ uint64_t Coordinator::Impl::commit_result(JobState& job, size_t unit, uint64_t w
         if (!records.empty()) st.save_training(id, index, pass, records);
         // (This pass's row is stored without its bytes and the earlier ones' were dropped: nothing
         // for the checkpoint to drop, hence `from` = `passes`.)
-        if (cp) st.save_checkpoint(id, index, cp->passes, cp->passes, encode_checkpoint(id, *cp));
+        if (cp) st.save_checkpoint(id, index, cp->passes, encode_checkpoint(id, *cp), {});
       },
       GroupCommit::Retry::No,
       [this, id = job.id(), unit, worker, upload, cp, n = bytes->view().size()](bool durable) TESSERA_REQUIRES(mu) {
@@ -158,8 +181,8 @@ void Coordinator::Impl::checkpoint_tile(JobState& job, uint32_t tile, uint32_t m
   if (!cp) return;
   auto shared = std::make_shared<JobState::Checkpoint>(std::move(*cp));
   (void)commits.append(
-      [id = job.id(), shared](Store& st) {
-        st.save_checkpoint(id, shared->tile, shared->from, shared->passes, encode_checkpoint(id, *shared));
+      [id = job.id(), shared, held = job.tile_passes(shared->from, shared->passes)](Store& st) {
+        st.save_checkpoint(id, shared->tile, shared->passes, encode_checkpoint(id, *shared), held);
       },
       GroupCommit::Retry::No,
       [this, id = job.id(), tile = shared->tile, from = shared->from](bool durable) TESSERA_REQUIRES(mu) {
@@ -194,14 +217,14 @@ BodyLimit Coordinator::result_limit(uint64_t worker, uint64_t lease) {
     if (job) {
       const TileRect& r = job->rect(l->unit);
       const bool aovs = job->plan().settings.sums_aovs(), training = job->sequencer().pass(job->pass_of(l->unit)).feeds.has_value();
-      return {max_tile_result_bytes(r, aovs, training),
+      return {max_tile_result_bytes(r, aovs, training, job->tile_leaves_state(l->unit)),
               "a result of lease " + std::to_string(lease) + " (a " + std::to_string(r.width()) + "x" +
                   std::to_string(r.height()) + " tile" + (aovs ? ", with AOV sums" : "") +
                   (training ? ", with training records" : "") + ")"};
     }
   }
   const int t = s.opt.limits.max_tile_size;
-  return {max_tile_result_bytes({0, 0, t, t}, true, true),
+  return {max_tile_result_bytes({0, 0, t, t}, true, true, true),
           "a result of a lease this coordinator does not hold (as much as the largest unit: a " + std::to_string(t) +
               "x" + std::to_string(t) + " tile with AOV sums and training records)"};
 }
@@ -215,6 +238,7 @@ Result<ResultAck> Coordinator::upload_result(uint64_t worker, uint64_t /*lease*/
   Result<UnitUpload> decoded = decode_upload(bytes->view(), s.opt.limits.max_pixels);  // (off the lock)
   if (!decoded.ok()) return decoded.status;
   const UnitUpload& upload = decoded.value;
+  if (Status st = s.check_point_records(upload); !st.ok()) return st;
   s.adopt_worker(worker);
   // Decided here and appended to the group commit; its callback adds it to the job once durable.
   ResultAck ack{/*accepted=*/true, /*duplicate=*/false, next, std::nullopt};

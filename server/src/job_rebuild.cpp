@@ -62,10 +62,10 @@ std::unique_ptr<JobState> Coordinator::Impl::rebuild_job(const JobRow& row) {
     std::string err;
     if (!decode_tile_result(c.data, sums, err)) throw std::runtime_error(where + "stored checkpoint is corrupt: " + err);
     if (c.tile >= job->num_tiles() || c.passes == 0 || c.passes > job->num_passes() ||
-        !(sums.film.rect() == job->rect(job->unit(c.tile, 0))) || sums.film.has_aovs() != job->plan().settings.sums_aovs() ||
-        sums.sample_end != job->sample_end(job->unit(c.tile, c.passes - 1)))
+        !(sums.film.rect() == job->sequencer().tiles()[c.tile]) || sums.film.has_aovs() != job->plan().settings.sums_aovs() ||
+        sums.sample_end != job->tile_sample_end(c.passes))
       throw std::runtime_error(where + "stored checkpoint of tile " + std::to_string(c.tile) + " does not fit the job");
-    job->restore_checkpoint(c.tile, c.passes, std::move(sums.film));
+    job->restore_checkpoint(c.tile, c.passes, std::move(sums.film), std::move(sums.tile_state));
   });
   store.for_each_result(row.id, [&](ResultRow&& r) {
     if (!job->has_unit(r.tile, r.pass)) return;
@@ -79,7 +79,7 @@ std::unique_ptr<JobState> Coordinator::Impl::rebuild_job(const JobRow& row) {
     const UnitUpload& u = stored.value;
     if (job->is_tile_unit(unit) != bool(u.tile) || (u.tile && u.tile->film.has_aovs() != job->plan().settings.sums_aovs()))
       throw std::runtime_error(where + "a stored result of pass " + std::to_string(r.pass) + " does not fit the job");
-    (void)(u.tile ? job->add_result(unit, std::move(u.tile->film), r.worker)
+    (void)(u.tile ? job->add_result(unit, std::move(u.tile->film), r.worker, {}, std::move(u.tile->tile_state))
                   : job->add_splats(unit, std::move(u.splats->splats), r.worker));
   });
   job->end_rebuild();
@@ -93,6 +93,7 @@ std::string encode_checkpoint(uint64_t job, const JobState::Checkpoint& cp) {
   sums.pass = cp.passes - 1;
   sums.sample_end = cp.sample_end;
   sums.film = cp.sums;
+  sums.tile_state = cp.tile_state;
   // Uncompressed: a checkpoint is written for most results, by the group commit's one writer, and
   // compressing (even zstd's fastest mode) took a third of that writer's time to save a fifth of
   // the bytes (sums are noise in their low bits). One per tile is within the storage bound as is.

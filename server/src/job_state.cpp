@@ -24,8 +24,6 @@ bool parse_phase(const std::string& s, JobPhase& out) {
 
 std::string farm_program_error(const PassProgram& program) {
   if (program.films != 1) return "the farm combines one film per job";
-  for (const PassSpec& p : program.passes)
-    if (p.tile_state) return "the farm carries no per-tile state from a pass to the next";
   return {};
 }
 
@@ -34,9 +32,11 @@ namespace {
 PassSequencer job_sequencer(const JobPlan& plan) {
   // The same sequencer `tessera render` runs with these settings (path_program.h), with the passes
   // planned at submission.
-  PassSequencer seq = path_sequencer(job_program(plan), SequenceFrame{plan.window, plan.full_width, plan.full_height,
-                                                                  plan.settings.tile_size, plan.settings.sums_aovs()},
-                                     plan.guide);
+  const SequenceFrame frame{plan.window, plan.full_width, plan.full_height, plan.settings.tile_size,
+                            plan.settings.sums_aovs()};
+  // (A job whose passes feed point maps keeps their records, never their grids: it only stores them.)
+  PassSequencer seq = plan.points ? light_vertex_sequencer(job_program(plan), frame, plan.points, PointMapUse::Store)
+                                  : path_sequencer(job_program(plan), frame, plan.guide);
   if (std::string e = farm_program_error(seq.program()); !e.empty()) throw std::invalid_argument(e);
   return seq;
 }
@@ -133,10 +133,12 @@ bool JobState::add_unit_result(size_t unit, UnitResult&& result, uint64_t worker
   return true;
 }
 
-bool JobState::add_result(size_t unit, FilmTile&& tile, uint64_t worker, std::string_view training) {
+bool JobState::add_result(size_t unit, FilmTile&& tile, uint64_t worker, std::string_view training,
+                          std::string tile_state) {
   UnitResult result;
   result.tile = std::move(tile);
   result.records = std::string(training);
+  result.tile_state = std::move(tile_state);
   return add_unit_result(unit, std::move(result), worker);
 }
 
@@ -154,6 +156,7 @@ JobState::Checkpoint JobState::film_checkpoint(uint32_t t) const {
   cp.from = folded_[t];
   cp.passes = passes_in_film(t);
   cp.sums = seq_.films().tile_region(t);
+  cp.tile_state = seq_.tile_state(t, cp.passes);
   return cp;
 }
 
@@ -161,12 +164,13 @@ std::optional<JobState::Checkpoint> JobState::take_checkpoint(uint32_t t, uint32
   if (!film_allocated() || !has_film() || passes_in_film(t) < folded_[t] + std::max<uint32_t>(1, min_new))
     return std::nullopt;
   Checkpoint cp = film_checkpoint(t);
-  cp.sample_end = sample_end(unit(t, cp.passes - 1));
+  cp.sample_end = tile_sample_end(cp.passes);
   folded_[t] = cp.passes;
   return cp;
 }
 
-std::optional<JobState::Checkpoint> JobState::checkpoint_with(size_t u, const FilmTile& result) const {
+std::optional<JobState::Checkpoint> JobState::checkpoint_with(size_t u, const FilmTile& result,
+                                                              const std::string& tile_state) const {
   if (!is_tile_unit(u)) return std::nullopt;  // (a Paths unit's result is stored as it came)
   const uint32_t t = tile_of(u);
   if (!has_film() || pass_of(u) != passes_in_film(t) || folded_[t] != passes_in_film(t) || tile_committing_[t] > 0)
@@ -187,11 +191,26 @@ std::optional<JobState::Checkpoint> JobState::checkpoint_with(size_t u, const Fi
     if (cp.sums.has_aovs()) add_aov_sums(cp.sums.mutable_aovs()[i], result.aovs()[i]);
   }
   cp.sums.counters += result.counters;
+  cp.tile_state = tile_state;
   return cp;
 }
 
-void JobState::restore_checkpoint(uint32_t t, uint32_t passes, FilmTile&& sums) {
+uint32_t JobState::tile_sample_end(uint32_t next_pass) const {
+  for (uint32_t p = next_pass; p-- > 0;)
+    if (seq_.pass(p).kind == UnitKind::Tile) return seq_.pass(p).sample_begin + seq_.pass(p).samples;
+  return 0;
+}
+
+std::vector<uint32_t> JobState::tile_passes(uint32_t from, uint32_t to) const {
+  std::vector<uint32_t> out;
+  for (uint32_t p = from; p < to; ++p)
+    if (seq_.pass(p).kind == UnitKind::Tile) out.push_back(p);
+  return out;
+}
+
+void JobState::restore_checkpoint(uint32_t t, uint32_t passes, FilmTile&& sums, std::string tile_state) {
   seq_.films().restore_tile(t, passes, std::move(sums));
+  seq_.restore_tile_state(t, passes, std::move(tile_state));
   folded_[t] = passes;
 }
 

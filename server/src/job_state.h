@@ -12,6 +12,7 @@
 #include "tessera/render/noise_estimate.h"
 #include "tessera/sequence/guide_training.h"
 #include "tessera/sequence/pass_sequencer.h"
+#include "tessera/sequence/photon_program.h"
 
 #include <algorithm>
 #include <cstdint>
@@ -29,8 +30,8 @@ const char* phase_name(JobPhase p);
 bool parse_phase(const std::string& s, JobPhase& out);
 inline bool is_terminal(JobPhase p) { return p == JobPhase::Done || p == JobPhase::Failed || p == JobPhase::Cancelled; }
 
-/// Whether the farm can run `program`: Tile and Paths passes into one film. (Per-tile state and
-/// per-iteration films have no wire format or checkpoint yet; the sequencer runs them locally.)
+/// Whether the farm can run `program`: Tile and Paths passes into one film. (Per-iteration films
+/// have no checkpoint yet; the sequencer runs them locally.)
 std::string farm_program_error(const PassProgram& program);
 
 class JobState {
@@ -95,6 +96,17 @@ class JobState {
   std::optional<PassSamples> lease_samples(size_t unit) const { return seq_.work(unit).samples; }
   bool result_fits(size_t unit, const FilmTile& film) const { return seq_.fits(unit, film); }
   std::optional<Lease::Guide> lease_guide(size_t unit) const;
+  /// The per-pixel state a tile_state unit starts from (null for any other unit).
+  const std::string* lease_tile_state(size_t unit) const { return seq_.work(unit).tile_state; }
+  /// The kind of record a unit's records must be, checked before they reach add_result (off the
+  /// coordinator's lock): a job whose passes feed point maps has one.
+  std::optional<IntegratorType> point_records() const {
+    return plan_.points ? std::optional<IntegratorType>(plan_.points->type) : std::nullopt;
+  }
+  /// Whether a Tile unit's result must carry per-pixel state (sppm's gathers leave it).
+  bool tile_leaves_state(size_t unit) const {
+    return is_tile_unit(unit) && plan_.points && plan_.points->type == IntegratorType::Sppm;
+  }
   [[nodiscard]] bool check_training(size_t unit, std::string_view records, std::string& error) const {
     return seq_.check_records(unit, records, error);
   }
@@ -150,7 +162,8 @@ class JobState {
   }
   /// Adds a verified result (with a training unit's records, checked); false when the unit was
   /// already done (a duplicate).
-  bool add_result(size_t unit, FilmTile&& tile, uint64_t worker, std::string_view training = {});
+  bool add_result(size_t unit, FilmTile&& tile, uint64_t worker, std::string_view training = {},
+                  std::string tile_state = {});
   /// The same for a Paths unit's splats.
   bool add_splats(size_t unit, SplatSums&& splats, uint64_t worker, std::string_view records = {});
   /// Marks a unit done without its sums (a finished job resumed from its stored image, or a pass a
@@ -165,17 +178,23 @@ class JobState {
     uint32_t tile = 0, from = 0, passes = 0;  // results of passes from..passes-1 become redundant
     uint32_t sample_end = 0;                 // samples per pixel it holds
     FilmTile sums;                           // (with the counters of those passes)
+    std::string tile_state;                  // what the latest of those passes left (tile_state)
   };
   std::optional<Checkpoint> take_checkpoint(uint32_t tile, uint32_t min_new);
   /// The checkpoint the tile will have once `result` (for `unit`, about to be committed) is in:
   /// when it is the tile's next pass, every pass before it is in a checkpoint and no other result
   /// of the tile is being committed. Stored in the result's place, its bytes never need storing.
-  std::optional<Checkpoint> checkpoint_with(size_t unit, const FilmTile& result) const;
+  std::optional<Checkpoint> checkpoint_with(size_t unit, const FilmTile& result, const std::string& tile_state) const;
   void checkpoint_stored(uint32_t tile, uint32_t passes) { folded_[tile] = std::max(folded_[tile], passes); }
   /// Passes of the tile in the film (a stored result of an earlier pass is in a checkpoint).
   uint32_t passes_in_film(uint32_t tile) const { return seq_.films().next_pass(tile); }
   void checkpoint_failed(uint32_t tile, uint32_t from) { folded_[tile] = std::min(folded_[tile], from); }
-  void restore_checkpoint(uint32_t tile, uint32_t passes, FilmTile&& sums);
+  void restore_checkpoint(uint32_t tile, uint32_t passes, FilmTile&& sums, std::string tile_state = {});
+  /// Samples per pixel a tile's checkpoint of its passes before `next_pass` holds: the end of the
+  /// latest Tile pass among them (Paths passes between them add none of a tile's own).
+  uint32_t tile_sample_end(uint32_t next_pass) const;
+  /// The Tile passes among passes [from, to).
+  std::vector<uint32_t> tile_passes(uint32_t from, uint32_t to) const;
 
   // The image.
   Image image() const { return seq_.films().image(); }

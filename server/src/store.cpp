@@ -271,7 +271,8 @@ bool Store::add_result(uint64_t job, uint32_t tile, uint32_t pass, uint64_t work
   return !st.constraint();
 }
 
-void Store::save_checkpoint(uint64_t job, uint32_t tile, uint32_t from, uint32_t passes, const std::string& data) {
+void Store::save_checkpoint(uint64_t job, uint32_t tile, uint32_t passes, const std::string& data,
+                            const std::vector<uint32_t>& held) {
   WriteLock lock(write_mu_);
   // Updated in place: a tile's checkpoints all have one size, so SQLite overwrites the row's pages
   // rather than freeing and allocating them (fewer pages written per commit).
@@ -282,7 +283,7 @@ void Store::save_checkpoint(uint64_t job, uint32_t tile, uint32_t from, uint32_t
         .bind(int64_t(job)).bind(int64_t(tile)).bind(int64_t(passes)).blob(data).step();
   // The passes it holds keep their rows (for restart, retry and the lease log) without their bytes.
   Stmt drop(db_, prepared("UPDATE results SET data = x'' WHERE job = ? AND pass = ? AND tile = ?"));
-  for (uint32_t pass = from; pass < passes; ++pass) {
+  for (uint32_t pass : held) {
     drop.bind(int64_t(job)).bind(int64_t(pass)).bind(int64_t(tile)).step();
     drop.reset();
   }

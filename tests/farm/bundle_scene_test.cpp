@@ -275,19 +275,38 @@ TEST(JobPlan, GuidingFollowsTheJobElseTheScene) {
   EXPECT_TRUE(plan().guide);
 }
 
-// A scene file whose integrator is sppm is refused at planning, with what to do instead.
-TEST(JobPlan, AnSppmSceneIsRefused) {
+// A scene file whose integrator is sppm is planned as `tessera render` runs it: a photon pass
+// before each gather, and what makes its photon maps, kept with the plan (and through its JSON).
+// Settings only the path tracer has are refused, naming what to do instead.
+TEST(JobPlan, AnSppmScenePlansPhotonPassesAndItsMaps) {
   TempDir t;
   std::ofstream(t.path / "scene.xml") << R"(<scene version="0.6.0">
-  <integrator type="sppm"><integer name="photonCount" value="1000"/></integrator>
+  <integrator type="sppm"><integer name="photonCount" value="1000"/><float name="initialRadius" value="0.25"/>
+    <float name="alpha" value="0.6"/></integrator>
   <shape type="sphere"/>
+  <sensor type="perspective"><sampler type="independent"><integer name="sampleCount" value="3"/></sampler>
+    <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="6"/></film></sensor>
 </scene>)";
-  const JobSettings settings;
+  JobSettings settings;
+  auto plan = [&] {
+    return make_job_plan(t.path.string(), "scene.xml", settings, load_job_scene(t.path.string(), "scene.xml", settings));
+  };
+  const JobPlan p = plan();
+  ASSERT_TRUE(p.points);
+  EXPECT_EQ(p.points->type, IntegratorType::Sppm);
+  EXPECT_EQ(p.points->radius(5), 0.25f);
+  EXPECT_TRUE(p.program.passes == photon_program(3, 1000).passes);
+  JobPlan back;
+  std::string error;
+  ASSERT_TRUE(job_plan_from_json(to_json(p), back, error)) << error;
+  EXPECT_TRUE(back.points == p.points);
+  EXPECT_TRUE(back.program.passes == p.program.passes);
+  settings.target_error = 0.01;
   try {
-    (void)make_job_plan(t.path.string(), "scene.xml", settings, load_job_scene(t.path.string(), "scene.xml", settings));
-    ADD_FAILURE() << "planned";
+    (void)plan();
+    ADD_FAILURE() << "planned with a target error";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("tessera render --integrator sppm"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("a target error needs the path tracer"), std::string::npos) << e.what();
   }
 }
 

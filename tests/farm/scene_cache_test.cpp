@@ -3,6 +3,7 @@
 #include "tessera/farm/bundle.h"
 #include "tessera/farm/sha256.h"
 #include "tessera/sequence/guide_artifact.h"
+#include "tessera/sequence/photon_program.h"
 #include "tessera/scene/error.h"
 #include "tessera/worker/scene_cache.h"
 #include "test_support.h"
@@ -136,10 +137,11 @@ TEST(SceneCache, ArtifactsAreFetchedOnceCheckedAndCountedAgainstTheBudget) {
   Lease lease;
   lease.job_id = 3;
   lease.guide = Lease::Guide{hash, 1, false};
+  const Scene path_scene;  // (a guide is a path tracer's)
   {
     farm::SceneCache cache(dir.path.string(), uint64_t(1) << 30);
-    auto first = cache.guide(lease, api);
-    auto again = cache.guide(lease, api);
+    auto first = cache.guide(lease, api, path_scene);
+    auto again = cache.guide(lease, api, path_scene);
     EXPECT_EQ(first.get(), again.get());
     EXPECT_EQ(server.requests.load(), 1) << "fetched once";
     ASSERT_TRUE(first->guide);
@@ -149,7 +151,7 @@ TEST(SceneCache, ArtifactsAreFetchedOnceCheckedAndCountedAgainstTheBudget) {
     Lease corrupt = lease;
     corrupt.guide->hash = wrong;
     try {
-      (void)cache.guide(corrupt, api);
+      (void)cache.guide(corrupt, api, path_scene);
       ADD_FAILURE() << "a guide whose bytes are not its hash's was taken";
     } catch (const std::runtime_error& e) {
       EXPECT_NE(std::string(e.what()).find("hash mismatch"), std::string::npos) << e.what();
@@ -157,11 +159,39 @@ TEST(SceneCache, ArtifactsAreFetchedOnceCheckedAndCountedAgainstTheBudget) {
   }
   farm::SceneCache tight(dir.path.string(), /*budget=*/1);
   Lease scene = cached_lease(dir, kXml, 8);
-  (void)tight.guide(lease, api);
+  (void)tight.guide(lease, api, path_scene);
   EXPECT_EQ(tight.loaded_scenes(), 1u);
   (void)tight.get(scene, api);  // the guide is not in use: evicted for the scene
   EXPECT_EQ(tight.loaded_scenes(), 1u);
   EXPECT_EQ(tight.memory().scenes, 1u);
+}
+
+// An sppm job's artifact is its photon map: decoded with its grid, as the scene's integrator says.
+TEST(SceneCache, AnSppmJobsArtifactIsItsPhotonMap) {
+  TempDir dir;
+  ArtifactServer server;
+  std::vector<Photon> photons(100);
+  for (size_t i = 0; i < photons.size(); ++i) {
+    photons[i].p[0] = float(i) * 0.01f;
+    photons[i].power[1] = 1.f;
+    photons[i].length = 2;
+  }
+  const std::string bytes = PointRecordsArtifact(0.05f, {grid_records(photons)}).encode(), hash = sha256_hex(bytes);
+  server.by_hash[hash] = bytes;
+  const client::FarmApi api{client::FarmClient(server.url())};
+  Lease lease;
+  lease.job_id = 4;
+  lease.guide = Lease::Guide{hash, 0, false};
+  Scene sppm_scene;
+  sppm_scene.integrator.type = IntegratorType::Sppm;
+  farm::SceneCache cache(dir.path.string(), uint64_t(1) << 30);
+  auto map = cache.guide(lease, api, sppm_scene);
+  const auto* grid = dynamic_cast<const PhotonMapArtifact*>(map->points.get());
+  ASSERT_NE(grid, nullptr);
+  EXPECT_EQ(grid->grid().size(), photons.size());
+  EXPECT_EQ(grid->grid().max_radius(), 0.05f);
+  EXPECT_EQ(cache.memory().scene_bytes, grid->memory_bytes()) << "counted against the budget";
+  EXPECT_FALSE(map->guide);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include "tessera/farm/bundle.h"
 #include "tessera/sequence/guide_artifact.h"
+#include "tessera/sequence/photon_program.h"
 #include "tessera/farm/job_scene.h"
 #include "tessera/farm/mapped_file.h"
 #include "tessera/farm/sha256.h"
@@ -77,20 +78,26 @@ std::shared_ptr<const CachedScene> SceneCache::get(const Lease& lease, const cli
   return cached(scene_cache_key(lease.settings, lease.scene_file), [&] { return load(lease, api); });
 }
 
-std::shared_ptr<const CachedScene> SceneCache::guide(const Lease& lease, const client::FarmApi& api) {
+std::shared_ptr<const CachedScene> SceneCache::guide(const Lease& lease, const client::FarmApi& api, const Scene& scene) {
   const std::string& hash = lease.guide.value().hash;
   return cached("guide " + hash, [&] {
     client::HttpReply r = api.download_guide(hash);
     if (!r.ok()) throw std::runtime_error("cannot download guide " + hash + ": " + r.describe());
     if (sha256_hex(r.body) != hash) throw std::runtime_error("guide " + hash + " arrived corrupt (hash mismatch)");
-    auto tree = std::make_unique<SpatialTree>();
-    std::string error;
-    if (!decode_guide(r.body, *tree, error)) throw std::runtime_error(error);
     auto out = std::make_shared<CachedScene>();
-    out->bytes = tree->bytes();
-    out->guide = std::move(tree);
-    spdlog::info("downloaded guide {} of job {} ({} bytes, {} MB in memory)", hash.substr(0, 12), lease.job_id,
-                 r.body.size(), out->bytes >> 20);
+    std::string error;
+    if (uses_light_vertex_passes(scene.integrator.type)) {
+      out->points = decode_point_map(scene.integrator.type, r.body, error);
+      if (!out->points) throw std::runtime_error("point map " + hash.substr(0, 12) + ": " + error);
+      out->bytes = out->points->memory_bytes();
+    } else {
+      auto tree = std::make_unique<SpatialTree>();
+      if (!decode_guide(r.body, *tree, error)) throw std::runtime_error(error);
+      out->bytes = tree->bytes();
+      out->guide = std::move(tree);
+    }
+    spdlog::info("downloaded {} {} of job {} ({} bytes, {} MB in memory)", out->points ? "point map" : "guide",
+                 hash.substr(0, 12), lease.job_id, r.body.size(), out->bytes >> 20);
     return out;
   });
 }

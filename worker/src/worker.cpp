@@ -181,9 +181,8 @@ std::optional<Lease> Worker::process(const Lease& lease) {
   std::string bytes;
   try {
     scene = cache_.get(lease, api_);
-    if (lease.guide) guide = cache_.guide(lease, api_);
-    bytes = lease.paths ? encode_splat_result(render_paths_lease(*scene->scene, lease))
-                        : encode_tile_result(render_lease(*scene->scene, lease, guide ? guide->guide.get() : nullptr));
+    if (lease.guide) guide = cache_.guide(lease, api_, *scene->scene);
+    bytes = render(*scene->scene, lease, guide.get());
   } catch (const std::exception& e) {  // (a scene that does not load, a unit this build cannot render)
     finish();
     ++stats_.failures;
@@ -199,6 +198,14 @@ std::optional<Lease> Worker::process(const Lease& lease) {
   ++stats_.passes_uploaded;
   if (ack->next) ++leases_taken_;
   return std::move(ack->next);
+}
+
+std::string Worker::render(const Scene& scene, const Lease& lease, const CachedScene* artifact) {
+  if (uses_light_vertex_passes(scene.integrator.type))
+    return lease.paths ? encode_splat_result(render_light_vertex_paths(scene, lease))
+                       : encode_tile_result(render_light_vertex_tile(scene, lease, artifact ? artifact->points.get() : nullptr));
+  return lease.paths ? encode_splat_result(render_paths_lease(scene, lease))
+                     : encode_tile_result(render_lease(scene, lease, artifact ? artifact->guide.get() : nullptr));
 }
 
 std::optional<client::ResultAck> Worker::upload(const Lease& lease, const std::string& bytes) {

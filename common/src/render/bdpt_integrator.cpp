@@ -302,13 +302,14 @@ std::unique_ptr<Integrator> make_bdpt_integrator(const IntegratorSettings& setti
   return std::make_unique<BdptIntegrator>(settings);
 }
 
-float vcm_radius(const Scene& scene, uint32_t iteration) {
-  float r0 = scene.integrator.initial_radius;
-  if (!(r0 > 0.f)) {
-    const Bounds3 b = scene.bounds();
-    r0 = 0.003f * (b.empty() ? 1.f : std::max(0.5f * length(b.diagonal()), 1e-4f));  // (SmallVCM's)
-  }
-  return r0 / std::pow(float(iteration) + 1.f, 0.5f * (1.f - scene.integrator.alpha));
+float vcm_initial_radius(const Scene& scene) {
+  if (scene.integrator.initial_radius > 0.f) return scene.integrator.initial_radius;
+  const Bounds3 b = scene.bounds();
+  return 0.003f * (b.empty() ? 1.f : std::max(0.5f * length(b.diagonal()), 1e-4f));  // (SmallVCM's)
+}
+
+float vcm_radius(float initial_radius, float alpha, uint32_t iteration) {
+  return initial_radius / std::pow(float(iteration) + 1.f, 0.5f * (1.f - alpha));
 }
 
 std::unique_ptr<Integrator> make_vcm_integrator(const IntegratorSettings& settings, const VcmIteration& it) {

@@ -140,7 +140,11 @@ bool PassSequencer::add_result(size_t unit, UnitResult&& result) {
   mark_done(unit);
   // (Records first: a barrier this result completes may build the artifact they feed.)
   if (spec.feeds && !result.records.empty()) builder_->add_records(*spec.feeds, unit, result.records);
-  if (!tile_states_.empty()) tile_states_[unit] = std::move(result.tile_state);
+  if (!tile_states_.empty()) {
+    tile_states_[unit] = std::move(result.tile_state);
+    // (The state it started from is spent: only each tile's latest is kept, not one per pass.)
+    if (spec.tile_state) std::string().swap(tile_states_[unit_begin_[state_pass(p)] + i]);
+  }
   if (spec.kind == UnitKind::Tile) films_.add_tile(p, i, std::move(result.tile));
   else films_.add_splat(p, i, std::move(result.splats));
   advance();
@@ -248,6 +252,21 @@ void PassSequencer::restore_artifacts(std::vector<std::string> hashes, std::shar
   build_seconds_.assign(hashes.size(), 0.0);
   handed_out_ = hashes.size();
   hashes_ = std::move(hashes);
+}
+
+// The unit of the tile's latest Tile pass before `next_pass` (> 0).
+size_t PassSequencer::state_unit(uint32_t tile, uint32_t next_pass) const {
+  const uint32_t p = program_.passes[next_pass - 1].kind == UnitKind::Tile ? next_pass - 1 : state_pass(next_pass - 1);
+  return unit_begin_[p] + tile;
+}
+
+void PassSequencer::restore_tile_state(uint32_t tile, uint32_t next_pass, std::string state) {
+  if (!tile_states_.empty() && next_pass > 0) tile_states_[state_unit(tile, next_pass)] = std::move(state);
+}
+
+const std::string& PassSequencer::tile_state(uint32_t tile, uint32_t next_pass) const {
+  static const std::string kNone;
+  return tile_states_.empty() || next_pass == 0 ? kNone : tile_states_[state_unit(tile, next_pass)];
 }
 
 void PassSequencer::release() {

@@ -24,28 +24,56 @@ bool valid(const LightVertexRecord& v) {
          std::isfinite(v.d_vm) && v.d_vcm >= 0.f && v.d_vm >= 0.f;
 }
 
-// Records from untrusted bytes: whole records, each valid, at most the cap.
+// Whether untrusted bytes are whole valid records, at most the cap with `held` bytes already in.
 template <typename R>
-bool read_records(std::string_view bytes, std::vector<R>& out, std::string& error) {
+bool check_records_of(std::string_view bytes, uint64_t held, std::string& error) {
   if (bytes.size() % sizeof(R) != 0) {
     error = "records: " + std::to_string(bytes.size()) + " bytes is not a whole number of " +
             std::to_string(sizeof(R)) + "-byte records";
     return false;
   }
-  if (out.size() * sizeof(R) + bytes.size() > kMaxPhotonMapBytes) {
+  if (held + bytes.size() > kMaxPhotonMapBytes) {
     error = "records: a pass's points exceed the cap of " + std::to_string(kMaxPhotonMapBytes) + " bytes";
     return false;
   }
+  return true;
+}
+
+template <typename R>
+bool check_values(std::string_view bytes, std::string& error) {
+  for (size_t i = 0; i < bytes.size() / sizeof(R); ++i) {
+    R r;
+    std::memcpy(static_cast<void*>(&r), bytes.data() + i * sizeof(R), sizeof(R));
+    if (!valid(r)) {
+      error = "records: record " + std::to_string(i) + " is not finite or out of range";
+      return false;
+    }
+  }
+  return true;
+}
+
+// Records from untrusted bytes: whole records, each valid, at most the cap.
+template <typename R>
+bool read_records(std::string_view bytes, std::vector<R>& out, std::string& error) {
+  if (!check_records_of<R>(bytes, out.size() * sizeof(R), error) || !check_values<R>(bytes, error)) return false;
   const size_t first = out.size();
   out.resize(first + bytes.size() / sizeof(R));
   if (!bytes.empty()) std::memcpy(static_cast<void*>(out.data() + first), bytes.data(), bytes.size());
-  for (size_t i = first; i < out.size(); ++i)
-    if (!valid(out[i])) {
-      error = "records: record " + std::to_string(i - first) + " is not finite or out of range";
-      out.resize(first);
-      return false;
-    }
   return true;
+}
+
+// The artifact's bytes: zstd of the radius and the records.
+std::string encode_points(float radius, const std::vector<std::string_view>& parts) {
+  size_t size = sizeof radius;
+  for (std::string_view p : parts) size += p.size();
+  std::string raw;
+  raw.reserve(size);
+  raw.append(reinterpret_cast<const char*>(&radius), sizeof radius);
+  for (std::string_view p : parts) raw.append(p);
+  std::string out(ZSTD_compressBound(raw.size()), '\0');
+  const size_t n = ZSTD_compress(out.data(), out.size(), raw.data(), raw.size(), 1);
+  out.resize(ZSTD_isError(n) ? 0 : n);  // (compressBound makes an error impossible)
+  return out;
 }
 
 // A pass of `paths` in about 16 units (so that every thread of a machine has some), from 1,024 to
@@ -103,29 +131,62 @@ PassProgram vcm_program(uint32_t spp, uint64_t window_pixels) {
   return program;
 }
 
+float PointMapPlan::radius(uint32_t iteration) const {
+  return type == IntegratorType::Sppm ? initial_radius : vcm_radius(initial_radius, alpha, iteration);
+}
+
+std::optional<PointMapPlan> point_map_plan(const Scene& scene) {
+  const IntegratorSettings& s = scene.integrator;
+  if (s.type == IntegratorType::Sppm) return PointMapPlan{s.type, sppm_initial_radius(scene), s.alpha};
+  if (s.type == IntegratorType::Vcm && s.merge) return PointMapPlan{s.type, vcm_initial_radius(scene), s.alpha};
+  return std::nullopt;
+}
+
+PassProgram light_vertex_program(const Scene& scene, uint32_t spp, uint64_t window_pixels) {
+  const IntegratorSettings& s = scene.integrator;
+  if (s.type == IntegratorType::Sppm) return photon_program(sppm_passes(s, spp), s.photon_count);
+  TESSERA_CHECK(s.type == IntegratorType::Vcm);
+  if (s.merge) return vcm_program(spp, window_pixels);
+  return path_program(PathProgramOptions{spp, 0, false, {}, std::nullopt, traces_light_paths(s)});
+}
+
 template <typename R>
 std::string GridArtifact<R>::encode() const {
-  const float radius = grid_.max_radius();
-  std::string raw(reinterpret_cast<const char*>(&radius), sizeof radius);
-  raw += grid_records(grid_.records());
-  std::string out(ZSTD_compressBound(raw.size()), '\0');
-  const size_t n = ZSTD_compress(out.data(), out.size(), raw.data(), raw.size(), 1);
-  out.resize(ZSTD_isError(n) ? 0 : n);  // (compressBound makes an error impossible)
-  return out;
+  return encode_points(grid_.max_radius(), {std::string_view(reinterpret_cast<const char*>(grid_.records().data()),
+                                                             grid_.records().size() * sizeof(R))});
+}
+
+std::string PointRecordsArtifact::encode() const {
+  return encode_points(radius_, std::vector<std::string_view>(records_.begin(), records_.end()));
+}
+
+size_t PointRecordsArtifact::memory_bytes() const {
+  size_t n = 0;
+  for (const std::string& r : records_) n += r.size();
+  return n;
 }
 
 template <typename R>
 std::shared_ptr<const Artifact> GridBuilder<R>::build(uint32_t iteration) {
   TESSERA_CHECK(iteration == next_);
-  std::vector<R> points;
+  ++next_;
+  const float radius = radius_(iteration);
+  std::map<uint64_t, std::string> records = std::move(records_);
+  records_.clear();
+  bytes_ = 0;
+  if (use_ == PointMapUse::Store) {
+    std::vector<std::string> parts;
+    parts.reserve(records.size());
+    for (auto& [unit, bytes] : records) parts.push_back(std::move(bytes));
+    return std::make_shared<const PointRecordsArtifact>(radius, std::move(parts));
+  }
   size_t total = 0;
-  for (const auto& [unit, bytes] : records_) total += bytes.size() / sizeof(R);
+  for (const auto& [unit, bytes] : records) total += bytes.size() / sizeof(R);
+  std::vector<R> points;
   points.reserve(total);
   std::string error;
-  for (const auto& [unit, bytes] : records_) TESSERA_CHECK(read_records(bytes, points, error));  // (checked on arrival)
-  records_.clear();
-  ++next_;
-  return std::make_shared<const GridArtifact<R>>(PointGrid<R>(std::move(points), radius_(iteration)));
+  for (const auto& [unit, bytes] : records) TESSERA_CHECK(read_records(bytes, points, error));  // (our own)
+  return std::make_shared<const GridArtifact<R>>(PointGrid<R>(std::move(points), radius));
 }
 
 template <typename R>
@@ -134,14 +195,15 @@ bool GridBuilder<R>::check_records(uint32_t iteration, std::string_view records,
     error = "records for pass " + std::to_string(iteration) + " while pass " + std::to_string(next_) + " is fed";
     return false;
   }
-  std::vector<R> points;
-  return read_records(records, points, error);
+  return check_records_of<R>(records, bytes_, error);
 }
 
 template <typename R>
 void GridBuilder<R>::add_records(uint32_t iteration, uint64_t unit, std::string_view records) {
   TESSERA_CHECK(iteration == next_);
-  records_[unit] = std::string(records);
+  std::string& held = records_[unit];
+  bytes_ = bytes_ - held.size() + records.size();
+  held = std::string(records);
 }
 
 template <typename R>
@@ -160,14 +222,20 @@ std::shared_ptr<const Artifact> GridBuilder<R>::decode(std::string_view bytes, s
     error = "point map: corrupt or truncated";
     return nullptr;
   }
+  const std::string_view records = std::string_view(raw).substr(sizeof radius);
+  if (use_ == PointMapUse::Store) {
+    if (!check_records_of<R>(records, 0, error) || !check_values<R>(records, error)) return nullptr;
+    return std::make_shared<const PointRecordsArtifact>(radius, std::vector<std::string>{std::string(records)});
+  }
   std::vector<R> points;
-  if (!read_records(std::string_view(raw).substr(sizeof radius), points, error)) return nullptr;
+  if (!read_records(records, points, error)) return nullptr;
   return std::make_shared<const GridArtifact<R>>(PointGrid<R>(std::move(points), radius));
 }
 
 template <typename R>
 void GridBuilder<R>::restore(uint32_t iteration, std::shared_ptr<const Artifact> /*artifact*/) {
   records_.clear();
+  bytes_ = 0;
   next_ = iteration + 1;
 }
 
@@ -176,18 +244,49 @@ template class GridArtifact<LightVertexRecord>;
 template class GridBuilder<Photon>;
 template class GridBuilder<LightVertexRecord>;
 
-PassSequencer light_vertex_sequencer(const Scene& scene, uint32_t spp, const SequenceFrame& frame) {
-  const IntegratorSettings& s = scene.integrator;
-  if (s.type == IntegratorType::Sppm) {
-    const float r0 = sppm_initial_radius(scene);
-    return PassSequencer(photon_program(sppm_passes(s, spp), s.photon_count), frame,
-                         std::make_unique<GridBuilder<Photon>>([r0](uint32_t) { return r0; }));
+bool check_point_records(IntegratorType type, std::string_view records, std::string& error) {
+  if (type == IntegratorType::Sppm) return check_records_of<Photon>(records, 0, error) && check_values<Photon>(records, error);
+  return check_records_of<LightVertexRecord>(records, 0, error) && check_values<LightVertexRecord>(records, error);
+}
+
+std::shared_ptr<const Artifact> decode_point_map(IntegratorType type, std::string_view bytes, std::string& error) {
+  auto no_radius = [](uint32_t) { return 0.f; };  // (decoding takes the stored one)
+  if (type == IntegratorType::Sppm) return GridBuilder<Photon>(no_radius).decode(bytes, error);
+  return GridBuilder<LightVertexRecord>(no_radius).decode(bytes, error);
+}
+
+bool check_sppm_state(std::string_view state, size_t pixels, std::string& error) {
+  if (state.size() != pixels * sizeof(SppmPixel)) {
+    error = "per-pixel state of " + std::to_string(state.size()) + " bytes, not " + std::to_string(pixels) + " pixels of " +
+            std::to_string(sizeof(SppmPixel));
+    return false;
   }
-  TESSERA_CHECK(s.type == IntegratorType::Vcm);
-  if (!s.merge) return path_sequencer(PathProgramOptions{spp, 0, false, {}, std::nullopt, traces_light_paths(s)}, frame);
-  const Scene* sc = &scene;
-  return PassSequencer(vcm_program(spp, uint64_t(frame.window.area())), frame,
-                       std::make_unique<GridBuilder<LightVertexRecord>>([sc](uint32_t k) { return vcm_radius(*sc, k); }));
+  for (size_t i = 0; i < pixels; ++i) {
+    SppmPixel px;
+    std::memcpy(static_cast<void*>(&px), state.data() + i * sizeof px, sizeof px);
+    const bool ok = std::isfinite(px.radius) && px.radius >= 0.f && std::isfinite(px.n) && px.n >= 0.f &&
+                    std::isfinite(px.tau[0]) && std::isfinite(px.tau[1]) && std::isfinite(px.tau[2]) &&
+                    px.tau[0] >= 0 && px.tau[1] >= 0 && px.tau[2] >= 0;
+    if (!ok) {
+      error = "per-pixel state: pixel " + std::to_string(i) + " is not finite or out of range";
+      return false;
+    }
+  }
+  return true;
+}
+
+PassSequencer light_vertex_sequencer(const Scene& scene, uint32_t spp, const SequenceFrame& frame) {
+  return light_vertex_sequencer(light_vertex_program(scene, spp, uint64_t(frame.window.area())), frame,
+                                point_map_plan(scene), PointMapUse::Render);
+}
+
+PassSequencer light_vertex_sequencer(PassProgram program, const SequenceFrame& frame,
+                                     const std::optional<PointMapPlan>& plan, PointMapUse use) {
+  if (!plan) return path_sequencer(std::move(program), frame, std::nullopt);
+  auto radius = [p = *plan](uint32_t k) { return p.radius(k); };
+  if (plan->type == IntegratorType::Sppm)
+    return PassSequencer(std::move(program), frame, std::make_unique<GridBuilder<Photon>>(radius, use));
+  return PassSequencer(std::move(program), frame, std::make_unique<GridBuilder<LightVertexRecord>>(radius, use));
 }
 
 namespace {

@@ -62,26 +62,19 @@ class LightVertexUnits final : public UnitRenderer {
   uint32_t seed_;
 };
 
-// What no technique but the path tracer has: a per-pixel noise estimate, guides, AOVs.
-void check_settings(const Scene& scene, const RenderSettings& settings) {
-  const IntegratorType type = scene.integrator.type;
-  if (settings.aovs && (is_bidirectional(type) || uses_light_vertex_passes(type)))
-    throw std::invalid_argument("AOVs and denoising need the path tracer (integrator path or volpath): the " +
-                                std::string(integrator_name(type)) +
-                                " integrator's image is not the mean of a pixel's own samples");
-  if (!uses_light_vertex_passes(type)) return;
-  const char* what = settings.target_error > 0 ? "a target error"
-                     : settings.adaptive        ? "adaptive sampling"
-                     : settings.guiding.value_or(false) ? "path guiding"
-                                                        : nullptr;
-  if (what)
-    throw std::invalid_argument(std::string("the ") + integrator_name(type) +
-                                " integrator's passes refine an estimate from the light of their own pass, which a "
-                                "pixel's samples do not show the noise of: " +
-                                what + " needs the path tracer (integrator path or volpath)");
-}
-
 }  // namespace
+
+std::string technique_settings_error(IntegratorType type, bool aovs, double target_error, bool adaptive, bool guiding) {
+  if (aovs && (is_bidirectional(type) || uses_light_vertex_passes(type)))
+    return "AOVs and denoising need the path tracer (integrator path or volpath): the " + std::string(integrator_name(type)) +
+           " integrator's image is not the mean of a pixel's own samples";
+  if (!uses_light_vertex_passes(type)) return {};
+  const char* what = target_error > 0 ? "a target error" : adaptive ? "adaptive sampling" : guiding ? "path guiding" : nullptr;
+  if (!what) return {};
+  return std::string("the ") + integrator_name(type) +
+         " integrator's passes refine an estimate from the light of their own pass, which a pixel's samples do not "
+         "show the noise of: " + what + " needs the path tracer (integrator path or volpath)";
+}
 
 Film render(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress, RenderStats* stats) {
   const auto start = std::chrono::steady_clock::now();
@@ -89,7 +82,10 @@ Film render(const Scene& scene, const RenderSettings& settings, const ProgressCa
   PathProgramOptions options{uint32_t(settings.spp), settings.target_error, settings.adaptive, settings.adaptive_settings,
                              guide_plan(scene, settings.guiding, settings.guiding_settings),
                              traces_light_paths(scene.integrator)};
-  check_settings(scene, settings);
+  if (std::string e = technique_settings_error(scene.integrator.type, settings.aovs, settings.target_error,
+                                               settings.adaptive, settings.guiding.value_or(false));
+      !e.empty())
+    throw std::invalid_argument(e);
   const SequenceFrame frame{film_window(scene.film), scene.film.width, scene.film.height, settings.tile_size, settings.aovs};
   const bool light_vertices = uses_light_vertex_passes(scene.integrator.type);
   PassSequencer sequencer =

@@ -55,8 +55,14 @@ struct VcmIteration {
   double light_paths = 0;               // N_L
 };
 
-/// r_k for iteration k of `scene` (its initial radius, else 0.003 scene-sphere radii, and its alpha).
-float vcm_radius(const Scene& scene, uint32_t iteration);
+/// r_0 of `scene`: its initial radius, else 0.003 scene-sphere radii.
+float vcm_initial_radius(const Scene& scene);
+/// r_k = r_0 / (k+1)^((1-alpha)/2): what every machine computes for iteration k, bit for bit.
+float vcm_radius(float initial_radius, float alpha, uint32_t iteration);
+/// r_k for iteration k of `scene` (its initial radius and its alpha).
+inline float vcm_radius(const Scene& scene, uint32_t iteration) {
+  return vcm_radius(vcm_initial_radius(scene), scene.integrator.alpha, iteration);
+}
 
 /// Light paths [path_begin, path_end) of iteration `it` (numbered as trace_light_paths numbers
 /// them): their light tracing into `splats` (reset by the caller) and their non-delta vertices,

@@ -170,6 +170,12 @@ class PassSequencer {
   /// The stored artifacts' hashes in order and the latest one, decoded; records for the next follow.
   void restore_artifacts(std::vector<std::string> hashes, std::shared_ptr<const Artifact> latest);
   void restore_stopped() { stopped_ = true; }
+  /// A tile's per-pixel state as its latest Tile pass before `next_pass` left it (a checkpoint
+  /// holds that pass, whose own result is not stored); a no-op in a program without state.
+  void restore_tile_state(uint32_t tile, uint32_t next_pass, std::string state);
+  /// The state restore_tile_state() restores: the tile's latest Tile pass's before `next_pass`
+  /// (empty in a program without state, or before that pass is done).
+  const std::string& tile_state(uint32_t tile, uint32_t next_pass) const;
   /// Frees films, artifacts and plans of a render whose image is written.
   void release();
 
@@ -177,6 +183,7 @@ class PassSequencer {
   void advance();
   /// The Tile pass a tile_state pass's units start from: the latest before it.
   uint32_t state_pass(uint32_t pass) const;
+  size_t state_unit(uint32_t tile, uint32_t next_pass) const;
   bool at_barrier_decided_before(uint32_t pass) const;
   bool open_barrier(uint32_t pass);
   void build_artifact(uint32_t iteration);

@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <string>
 
 namespace tessera {
 
@@ -65,6 +66,11 @@ struct RenderProgress {
 };
 /// Called after every finished tile, from worker threads but never concurrently.
 using ProgressCallback = std::function<void(const RenderProgress&)>;
+
+/// Why a render of `type` cannot have these settings (empty when it can): only the path tracer has
+/// a per-pixel noise estimate (target error, adaptive sampling), guides and AOVs. `tessera render`
+/// and a farm job's plan both ask here.
+std::string technique_settings_error(IntegratorType type, bool aovs, double target_error, bool adaptive, bool guiding);
 
 /// Renders the scene's crop window with settings.spp samples per pixel.
 Film render(const Scene& scene, const RenderSettings& settings, const ProgressCallback& progress = {},

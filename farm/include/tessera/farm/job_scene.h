@@ -11,6 +11,7 @@
 #include "tessera/guiding/spatial_tree.h"
 #include "tessera/image/image.h"
 #include "tessera/sequence/path_program.h"
+#include "tessera/sequence/photon_program.h"
 #include "tessera/scene/load_context.h"
 
 #include <string>
@@ -30,6 +31,9 @@ struct JobPlan {
   /// A guided job: the SD-tree as render() starts it (over the scene's bounds) and its settings.
   using Guide = GuidePlan;
   std::optional<Guide> guide;
+  /// An sppm or vcm job whose passes feed maps: how the coordinator makes them (never from the
+  /// scene, which it does not load again after a restart).
+  std::optional<PointMapPlan> points;
   /// The passes the job was planned with (path_program() of path_options()): a coordinator that
   /// resumes it runs these, whatever a later build would plan for the same settings.
   PassProgram program;
@@ -70,6 +74,13 @@ void begin_tile_result(const Lease& lease, TileResult& out);
 /// Renders a lease's unit (what a worker does with it), timed. A guided lease needs its guide
 /// (Lease::guide, decoded): a unit that trains returns its training records with the result.
 TileResult render_lease(const Scene& scene, const Lease& lease, const SpatialTree* guide = nullptr);
+/// Renders a lease of an sppm or vcm job (uses_light_vertex_passes of the scene's integrator) as
+/// `tessera render` renders the unit (render_light_vertex_unit): a Tile lease's gather or camera
+/// tile, with the per-pixel state its tile's next pass starts from; `points`: the map it renders
+/// with (Lease::guide, decoded by decode_point_map), if any.
+TileResult render_light_vertex_tile(const Scene& scene, const Lease& lease, const Artifact* points);
+/// The same for a Paths lease: its photons' or light subpaths' records, and their splats.
+SplatResult render_light_vertex_paths(const Scene& scene, const Lease& lease);
 /// Renders a lease of light paths (Lease::paths) of a light-tracing integrator (render/bdpt.h):
 /// the splats its paths add to the film's window. Throws std::invalid_argument for a lease that
 /// is not one, or a scene whose integrator traces no light paths.

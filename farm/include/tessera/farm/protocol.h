@@ -66,11 +66,6 @@ struct JobLimits {
 };
 
 nlohmann::json to_json(const JobSettings& s);
-/// Why a job of the sppm or vcm integrator (given or in its scene file) is refused.
-inline constexpr const char* kFarmRefusesLightVertexPasses =
-    "the farm does not run the sppm and vcm integrators yet (their passes make a photon or light vertex map "
-    "that the next units render with, and sppm's carry per-pixel state from pass to pass): render the scene "
-    "with `tessera render --integrator sppm` (or vcm), or submit it with another integrator";
 /// `j` must be an object; `require_scene` demands the `scene` field (not for multipart uploads).
 /// `out_of_range` (if given) tells a number outside its field's range (the API's 422) from a
 /// malformed request (400); the error names the field and the range.
@@ -115,7 +110,14 @@ struct Lease {
     bool operator==(const Guide&) const = default;
   };
   std::optional<Guide> guide;
+  /// A Tile unit of a pass that starts from its tile's per-pixel state (PassSpec::tile_state: an
+  /// sppm gather's radii, counts and flux): the bytes its tile's previous gather left ("tile_state",
+  /// base64 on the wire).
+  std::string tile_state;
 };
+
+/// A lease's tile state is at most this many bytes (a largest tile's SppmPixels).
+inline constexpr size_t kMaxLeaseStateBytes = size_t(1024) * 1024 * 32;
 
 nlohmann::json to_json(const Lease& l);
 /// Bytes of to_json(l).dump() without serializing the job's part of it again: `job_part_bytes` is

@@ -9,8 +9,9 @@
 //   u64 n, n bytes of training records (guiding/tree_io.h; n = 0 unless the unit trains a guide),
 //   u64 m, m per-pixel AOV sums (render/aov.h: f64 albedo[3], normal[3], depth, half_sum[3], u64
 //   half_count; m is 0, or the rect's area for a job that is denoised),
-//   16-byte XXH3-128 checksum of everything above (big-endian canonical form). Format version 3,
-//   still read, has no AOV sums; version 2 no training records either; version 1 also ended in a
+//   u64 s, s bytes of per-pixel state (PassSpec::tile_state: an sppm gather's SppmPixels; else 0),
+//   16-byte XXH3-128 checksum of everything above (big-endian canonical form). Format version 4,
+//   still read, has no state; version 3 no AOV sums; version 2 no training records either; version 1 also ended in a
 //   32-byte SHA-256 instead.
 // The coordinator adds decoded tiles to its Film exactly as render() does, so the stitched image is
 // bit-identical to a local render (render/renderer.h).
@@ -31,7 +32,11 @@ struct TileResult {
   double seconds = 0;  // time the worker spent rendering it
   FilmTile film;       // rect, sums and counters
   std::string training;  // a guide-training unit's records (guiding/tree_io.h); else empty
+  std::string tile_state;  // the per-pixel state the tile's next pass starts from; else empty
 };
+
+/// Per-pixel state larger than this per pixel is refused (sppm's is 32 bytes).
+inline constexpr size_t kMaxStateBytesPerPixel = 64;
 
 /// Training records larger than this are refused (a unit's records are far smaller than its guide).
 inline constexpr size_t kMaxTrainingBytes = size_t(64) << 20;
@@ -45,9 +50,9 @@ inline constexpr size_t kTileResultDigestBytes = 16;
 inline constexpr int kUncompressed = -1000;
 
 /// The most bytes a result of a unit over `rect` can take as sent (compressed or not): its sums,
-/// the AOV sums with `aovs`, and training records with `training` (at most kMaxTrainingBytes). What
-/// the coordinator reads of an upload for that unit.
-uint64_t max_tile_result_bytes(const TileRect& rect, bool aovs, bool training);
+/// the AOV sums with `aovs`, training records with `training` (at most kMaxTrainingBytes) and
+/// per-pixel state with `state`. What the coordinator reads of an upload for that unit.
+uint64_t max_tile_result_bytes(const TileRect& rect, bool aovs, bool training, bool state = false);
 
 /// Encodes (and compresses) a result; `level` is zstd's compression level, or kUncompressed. Pixel
 /// sums are noise in their low bits: level 1 makes them as small as level 3 does (within 0.2%) in a

@@ -106,8 +106,10 @@ class Store {
   bool add_result(uint64_t job, uint32_t tile, uint32_t pass, uint64_t worker, std::string_view data,
                   double now);
   /// Stores a tile's checkpoint (its sums over passes 0..passes-1, tile_result.h bytes) and drops
-  /// the bytes of the results of passes from..passes-1, which it now holds; their rows stay.
-  void save_checkpoint(uint64_t job, uint32_t tile, uint32_t from, uint32_t passes, const std::string& data);
+  /// the bytes of the tile's results in `held` (its Tile passes from..passes-1, which it now holds:
+  /// a Paths pass's unit of the same index is not the tile's); their rows stay.
+  void save_checkpoint(uint64_t job, uint32_t tile, uint32_t passes, const std::string& data,
+                       const std::vector<uint32_t>& held);
   void for_each_checkpoint(uint64_t job, const std::function<void(CheckpointRow&&)>& fn);
   /// Calls `fn` for every result of `job`, ordered by pass then tile (`with_data`: the bytes too;
   /// empty for a pass a checkpoint holds).

@@ -52,6 +52,8 @@ class Worker {
   /// Delivers a result (asking for the next lease with it while this slot wants more work); its
   /// answer, or nothing when it could not be delivered.
   std::optional<client::ResultAck> upload(const Lease& lease, const std::string& bytes);
+  /// The lease's unit rendered and encoded, with the artifact it renders with (if any).
+  static std::string render(const Scene& scene, const Lease& lease, const CachedScene* artifact);
   bool wants_more() const { return !stop_ && (opt_.max_leases <= 0 || leases_taken_ < opt_.max_leases); }
   void backoff(int& attempt, bool interruptible = true);
 
