@@ -149,6 +149,8 @@ struct Coordinator::Impl {
   void restore_artifacts(JobState& job);
   /// Retention: the guide files no job names any more (and not just written), into `trash`.
   void collect_unused_guides(std::vector<std::filesystem::path>& trash);
+  /// Deletes a spent point map's file unless a row names it or it was written again since `written`.
+  void remove_spent_artifact(const std::string& hash, std::filesystem::file_time_type written) TESSERA_EXCLUDES(mu);
 
   // Phases (job_phases.cpp, job_denoise.cpp).
   /// The one place a job's phase changes: times, leases, event, image and webhook, and the phase

@@ -5,6 +5,7 @@
 #include "coordinator_impl.h"
 #include "event_log.h"
 
+#include "tessera/farm/splat_result.h"
 #include "tessera/farm/tile_result.h"
 
 #include <spdlog/spdlog.h>
@@ -17,6 +18,22 @@ namespace {
 Status unknown_worker(uint64_t id) {
   return make_error(Code::NotFound, "unknown_worker", "no worker " + std::to_string(id) + "; register again");
 }
+// The result without its records (its splats: none, for a photon unit).
+SplatResult without_records(const SplatResult& r) {
+  SplatResult out;
+  out.job_id = r.job_id;
+  out.pass = r.pass;
+  out.unit = r.unit;
+  out.path_begin = r.path_begin;
+  out.path_end = r.path_end;
+  out.seconds = r.seconds;
+  out.splats.reset(r.splats.window);
+  out.splats.counters = r.splats.counters;
+  out.splats.pixel = r.splats.pixel;
+  out.splats.value = r.splats.value;
+  return out;
+}
+
 }  // namespace
 
 Status Coordinator::Impl::durable(uint64_t ticket) {
@@ -140,9 +157,16 @@ uint64_t Coordinator::Impl::commit_result(JobState& job, size_t unit, uint64_t w
   // its result will be checked against this one.
   if (job.active_leases(unit) > 0) job.remember_digest(unit, upload.digest());
   return commits.append(
-      [id = job.id(), index = upload.index(), pass = upload.pass(), worker, cp, records = upload.records(),
-       data = cp ? nullptr : bytes, now = wall_seconds()](Store& st) {
-        (void)st.add_result(id, index, pass, worker, data ? data->view() : std::string_view(), now);
+      [id = job.id(), index = upload.index(), pass = upload.pass(), worker, cp, upload, data = cp ? nullptr : bytes,
+       now = wall_seconds()](Store& st) {
+        const std::string& records = upload.records();
+        // A photon unit (records, no splats) is stored without its records, which its training
+        // rows hold until its map is stored: a pass's photons are not kept twice, nor for ever.
+        const std::string stripped = upload.splats && upload.splats->splats.pixel.empty() && !records.empty()
+                                         ? encode_splat_result(without_records(*upload.splats))
+                                         : std::string();
+        const std::string_view row = !stripped.empty() ? std::string_view(stripped) : data ? data->view() : std::string_view();
+        (void)st.add_result(id, index, pass, worker, row, now);
         if (!records.empty()) st.save_training(id, index, pass, records);
         // (This pass's row is stored without its bytes and the earlier ones' were dropped: nothing
         // for the checkpoint to drop, hence `from` = `passes`.)

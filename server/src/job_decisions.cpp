@@ -9,7 +9,11 @@
 
 #include <spdlog/spdlog.h>
 
+#include <filesystem>
+
 namespace tessera::server {
+
+namespace fs = std::filesystem;
 
 void Coordinator::Impl::save_decisions(JobState& job) {
   save_pass_plans(job);
@@ -34,8 +38,10 @@ void Coordinator::Impl::save_artifacts(JobState& job) {
       const auto t0 = std::chrono::steady_clock::now();
       const std::string bytes = made.artifact->encode(), hash = sha256_hex(bytes);
       std::string error;
+      fs::file_time_type written;
       try {
         write_file_durably(guide_path(hash), bytes);
+        written = fs::last_write_time(guide_path(hash));
       } catch (const std::exception& e) {
         error = e.what();
       }
@@ -49,9 +55,26 @@ void Coordinator::Impl::save_artifacts(JobState& job) {
         return;
       }
       // Retried until stored, ahead of the leases appended after it: a lease that renders with
-      // the artifact is handed out only once its row is durable.
-      (void)commits.append([id, iteration = made.iteration, hash](Store& st) { st.save_guide(id, iteration, hash); },
-                           GroupCommit::Retry::UntilDurable);
+      // the artifact is handed out only once its row is durable. A point map's predecessor has
+      // no pass left that gathers from it (the barrier that built this one saw them done): its
+      // file goes once that is durable.
+      const std::optional<std::string> spent = job.spent_by(made.iteration);
+      std::optional<fs::file_time_type> spent_written;
+      if (auto it = job.artifacts_written.find(made.iteration - 1); spent && it != job.artifacts_written.end()) {
+        spent_written = it->second;
+        job.artifacts_written.erase(it);
+      }
+      if (job.plan().points) job.artifacts_written[made.iteration] = written;
+      (void)commits.append(
+          [id, iteration = made.iteration, hash, fed_before = job.first_pass_feeding_after(made.iteration),
+           spent = spent.has_value()](Store& st) {
+            st.save_guide(id, iteration, hash, fed_before);
+            if (spent) st.spend_guide(id, iteration - 1);
+          },
+          GroupCommit::Retry::UntilDurable, [this, spent, spent_written, hash](bool durable) TESSERA_REQUIRES(mu) {
+            if (durable && spent && spent_written && *spent != hash)
+              background.push([this, h = *spent, w = *spent_written] { remove_spent_artifact(h, w); });
+          });
       log_event(spdlog::level::info, "job.guide_stored",
                 {{"job", id}, {"iteration", made.iteration}, {"memory_bytes", made.artifact->memory_bytes()},
                  {"bytes", bytes.size()}, {"barrier_seconds", made.seconds}, {"seconds", seconds}});
@@ -59,6 +82,15 @@ void Coordinator::Impl::save_artifacts(JobState& job) {
       work_cv.notify_all();
     });
   }
+}
+
+void Coordinator::Impl::remove_spent_artifact(const std::string& hash, fs::file_time_type written) {
+  // (Another job may have the same bytes: its row names them, or, still being committed, it wrote
+  // the file again since. Either keeps it; retention collects it once no row names it.)
+  const fs::path path = guide_path(hash);
+  std::error_code ec;
+  if (store.guide_named(hash) || fs::last_write_time(path, ec) != written || ec) return;
+  fs::remove(path, ec);
 }
 
 }  // namespace tessera::server

@@ -69,6 +69,12 @@ std::vector<uint32_t> JobState::passes_feeding_next() const {
   return out;
 }
 
+uint32_t JobState::first_pass_feeding_after(uint32_t iteration) const {
+  for (uint32_t p = 0; p < num_passes(); ++p)
+    if (seq_.pass(p).feeds && *seq_.pass(p).feeds > iteration) return p;
+  return uint32_t(num_passes());
+}
+
 void JobState::restore_records(uint32_t pass, uint32_t tile, std::string_view records) {
   seq_.builder()->add_records(*seq_.pass(pass).feeds, unit(tile, pass), records);
 }

@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <optional>
@@ -127,6 +128,15 @@ class JobState {
   bool pass_decided(uint32_t pass) const { return seq_.pass_planned(pass); }
   void restore_artifacts(std::vector<std::string> hashes, std::shared_ptr<const Artifact> latest) {
     seq_.restore_artifacts(std::move(hashes), std::move(latest));
+  }
+  /// The first pass that feeds an iteration after `iteration` (the number of passes if none):
+  /// records of the passes before it are spent once `iteration` is stored.
+  uint32_t first_pass_feeding_after(uint32_t iteration) const;
+  /// The hash of the point map that storing iteration `iteration` spends (its predecessor, which
+  /// no pass gathers from any more), if the job makes point maps.
+  std::optional<std::string> spent_by(uint32_t iteration) const {
+    if (!plan_.points || iteration == 0 || iteration > seq_.artifacts_stored()) return std::nullopt;
+    return seq_.artifact_hash(iteration - 1);
   }
   /// The passes whose stored records go into the artifact made next (a restart mid-training).
   std::vector<uint32_t> passes_feeding_next() const;
@@ -244,6 +254,9 @@ class JobState {
   std::shared_ptr<const Image> denoised_preview;
   uint64_t denoised_preview_changes = 0;
   bool preview_denoise_pending = false;
+  // A point-map job's stored maps not yet spent: when their files were written (a spent map's file
+  // is removed only if no one wrote it since).
+  std::map<uint32_t, std::filesystem::file_time_type> artifacts_written;
 
  private:
   Checkpoint film_checkpoint(uint32_t tile) const;

@@ -307,11 +307,22 @@ void Store::for_each_pass_plan(uint64_t job, const std::function<void(uint32_t, 
   while (st.step()) fn(uint32_t(st.i(0)), st.s(1));
 }
 
-void Store::save_guide(uint64_t job, uint32_t iteration, const std::string& hash) {
+void Store::save_guide(uint64_t job, uint32_t iteration, const std::string& hash, uint32_t fed_before) {
   WriteLock lock(write_mu_);
   Stmt(db_, prepared("INSERT OR REPLACE INTO guides(job, iteration, hash) VALUES(?, ?, ?)"))
       .bind(int64_t(job)).bind(int64_t(iteration)).bind(hash).step();
-  Stmt(db_, prepared("DELETE FROM training WHERE job = ? AND pass < ?")).bind(int64_t(job)).bind(int64_t(iteration)).step();
+  Stmt(db_, prepared("DELETE FROM training WHERE job = ? AND pass < ?")).bind(int64_t(job)).bind(int64_t(fed_before)).step();
+}
+
+void Store::spend_guide(uint64_t job, uint32_t iteration) {
+  WriteLock lock(write_mu_);
+  Stmt(db_, prepared("UPDATE guides SET hash = '' WHERE job = ? AND iteration = ?")).bind(int64_t(job)).bind(int64_t(iteration)).step();
+}
+
+bool Store::guide_named(const std::string& hash) {
+  Stmt st(rd_, "SELECT 1 FROM guides WHERE hash = ? LIMIT 1");
+  st.bind(hash);
+  return st.step();
 }
 
 std::vector<std::string> Store::guides(uint64_t job) {
@@ -323,7 +334,7 @@ std::vector<std::string> Store::guides(uint64_t job) {
 }
 
 std::set<std::string> Store::guide_hashes() {
-  Stmt st(rd_, "SELECT DISTINCT hash FROM guides");
+  Stmt st(rd_, "SELECT DISTINCT hash FROM guides WHERE hash != ''");
   std::set<std::string> out;
   while (st.step()) out.insert(st.s(0));
   return out;

@@ -137,6 +137,8 @@ class Farm {
     FAIL() << "the server does not answer /healthz; its log ends with:\n" << text.substr(text.size() > 3000 ? text.size() - 3000 : 0);
   }
   void kill_server() { server_.kill_now(); }
+  /// The coordinator's --data-dir.
+  std::filesystem::path data_dir() const { return dir_.path / "data"; }
   pid_t server_pid() const { return server_.pid(); }
   int stop_server() { return server_.terminate(); }
   /// Serve https with this certificate and key; the harness's client and workers verify against

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 
 namespace tessera::test {
@@ -82,6 +83,11 @@ TEST(LightVertexFarm, KilledWorkerAndCoordinatorBetweenPhotonPassesKeepTheBits) 
   const nlohmann::json st = farm.wait_job(id, 300);
   ASSERT_EQ(st.value("state", ""), "done") << st.dump();
   EXPECT_EQ(differing_pixels(farm.image(id), local_render(scene, s)), 0);
+  // A photon map no pass gathers from any more is deleted (those spent before the restart, whose
+  // write times went with it, wait for retention).
+  size_t maps = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(farm.data_dir() / "guides")) maps += entry.is_regular_file();
+  EXPECT_LT(maps, 30u) << "of 40 photon maps";
 }
 
 TEST(LightVertexFarm, SettingsOnlyThePathTracerHasAreRefused) {

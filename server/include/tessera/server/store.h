@@ -118,9 +118,15 @@ class Store {
   void save_pass_plan(uint64_t job, uint32_t pass, const std::string& data);
   /// Calls `fn(pass, bytes)` for every stored pass plan of `job`, in pass order.
   void for_each_pass_plan(uint64_t job, const std::function<void(uint32_t, std::string&&)>& fn);
-  /// A guided job's tree of iteration `iteration` is stored (its file) under `hash`; the training
-  /// records of the passes before it are no longer needed and are dropped.
-  void save_guide(uint64_t job, uint32_t iteration, const std::string& hash);
+  /// A job's artifact of iteration `iteration` is stored (its file) under `hash`; the training
+  /// records of passes before `fed_before` (the passes that fed it or an earlier one) are no
+  /// longer needed and are dropped.
+  void save_guide(uint64_t job, uint32_t iteration, const std::string& hash, uint32_t fed_before);
+  /// Iteration `iteration` of the job's artifacts is needed by no pass any more (a point map whose
+  /// gathers are done): its row keeps its place, without its hash, and its file may go.
+  void spend_guide(uint64_t job, uint32_t iteration);
+  /// Whether any job's row names the artifact `hash`.
+  bool guide_named(const std::string& hash);
   /// The job's stored trees' hashes, by iteration.
   std::vector<std::string> guides(uint64_t job);
   /// Every job's (a guide file no job names is deleted by retention).
