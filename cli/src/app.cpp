@@ -27,15 +27,10 @@ void add_connection_options(CLI::App& command, ConnectionOptions& c) {
       ->check(CLI::ExistingFile);
 }
 
-void add_integrator_option(CLI::App& command, std::string& integrator, bool farm) {
-  // The loader's integrator names (LoadOptions::integrator); it checks them too, for the farm,
-  // which does not run sppm and vcm.
-  if (farm)
-    command.add_option("--integrator", integrator, "Override the integrator: path, volpath, direct, bdpt or ptracer")
-        ->check(CLI::IsMember({"path", "volpath", "direct", "bdpt", "ptracer"}));
-  else
-    command.add_option("--integrator", integrator, "Override the integrator: path, volpath, direct, bdpt, ptracer, sppm or vcm")
-        ->check(CLI::IsMember({"path", "volpath", "direct", "bdpt", "ptracer", "sppm", "vcm"}));
+void add_integrator_option(CLI::App& command, std::string& integrator) {
+  // The loader's integrator names (LoadOptions::integrator); it checks them too.
+  command.add_option("--integrator", integrator, "Override the integrator: path, volpath, direct, bdpt, ptracer, sppm or vcm")
+      ->check(CLI::IsMember({"path", "volpath", "direct", "bdpt", "ptracer", "sppm", "vcm"}));
 }
 
 int main_entry(int argc, char** argv) {

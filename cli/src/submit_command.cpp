@@ -282,7 +282,7 @@ Command add_submit_command(CLI::App& app) {
   s->add_option("--name", o->name,
                 "Job name (default: the scene's folder, and its file's stem unless that is 'scene': cornell-box)");
   s->add_option("-D", *defines, "Override a scene <default>: -D name=value");
-  add_integrator_option(*s, o->integrator, /*farm=*/true);
+  add_integrator_option(*s, o->integrator);
   s->add_option("--light-selection", o->light_selection, "power or bvh")->check(CLI::IsMember({"power", "bvh"}));
   s->add_option("--target-error", o->target_error, "Stop at this estimated relMSE (--spp is then the budget)")
       ->check(CLI::Range(0.0, 1.0));

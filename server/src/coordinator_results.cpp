@@ -250,7 +250,7 @@ BodyLimit Coordinator::result_limit(uint64_t worker, uint64_t lease) {
   const int t = s.opt.limits.max_tile_size;
   return {max_tile_result_bytes({0, 0, t, t}, true, true, true),
           "a result of a lease this coordinator does not hold (as much as the largest unit: a " + std::to_string(t) +
-              "x" + std::to_string(t) + " tile with AOV sums and training records)"};
+              "x" + std::to_string(t) + " tile with AOV sums, training records and per-pixel state)"};
 }
 
 std::string Coordinator::spool_dir() const { return (std::filesystem::path(impl_->opt.data_dir) / "tmp").string(); }

@@ -343,8 +343,8 @@ TEST(FarmAttack, AResultOverWhatItsUnitCanWeighIsRefusedUnread) {
                                                         auth + "Content-Length: 900000000\r\n"), 5);
   EXPECT_EQ(status_of(unknown), 413) << unknown;
   EXPECT_NE(unknown.find("a lease this coordinator does not hold (as much as the largest unit: a 1024x1024 tile with AOV "
-                         "sums and training records) may have at most " +
-                         std::to_string(max_tile_result_bytes({0, 0, 1024, 1024}, true, true))),
+                         "sums, training records and per-pixel state) may have at most " +
+                         std::to_string(max_tile_result_bytes({0, 0, 1024, 1024}, true, true, true))),
             std::string::npos) << unknown;
   EXPECT_TRUE(farm.client().get("/healthz", 5).ok());
 }

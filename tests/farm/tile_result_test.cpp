@@ -105,7 +105,7 @@ std::string zstd_frame(std::string_view raw) {
 TEST(TileResult, StoredUncompressedRoundTripsAndIsChecked) {
   const TileResult in = sample_result();
   const std::string raw = encode_tile_result(in, kUncompressed);
-  EXPECT_EQ(raw.size(), size_t(96 + 13 * 9 * 56 + 8 + 8 + kTileResultDigestBytes));
+  EXPECT_EQ(raw.size(), size_t(96 + 13 * 9 * 56 + 8 + 8 + 8 + kTileResultDigestBytes));
   EXPECT_EQ(raw.substr(0, 4), "TSTR");
   TileResult out;
   std::string error;
@@ -124,7 +124,7 @@ TEST(TileResult, StoredUncompressedRoundTripsAndIsChecked) {
 TEST(TileResult, ReadsVersionOneWithSha256) {
   const TileResult in = sample_result();
   std::string v1 = encode_tile_result(in, kUncompressed);
-  v1.resize(v1.size() - kTileResultDigestBytes - 16);  // (without version 3's training records and 4's AOVs)
+  v1.resize(v1.size() - kTileResultDigestBytes - 24);  // (without 3's training records, 4's AOVs and 5's state)
   const uint32_t version = 1;
   std::memcpy(v1.data() + 4, &version, 4);
   const Sha256Digest digest = sha256(v1);
@@ -155,7 +155,7 @@ TEST(TileResult, AovSumsRoundTripAndVersionThreeIsRead) {
       for (uint32_t s = 0; s < 3; ++s) with_aovs.add_sample({x, y}, Rgb(float(x), float(y), float(s)), s, f);
   in.film = with_aovs;
   const std::string raw = encode_tile_result(in, kUncompressed);
-  EXPECT_EQ(raw.size(), size_t(96 + 13 * 9 * (56 + 88) + 8 + 8 + kTileResultDigestBytes));
+  EXPECT_EQ(raw.size(), size_t(96 + 13 * 9 * (56 + 88) + 8 + 8 + 8 + kTileResultDigestBytes));
   TileResult out;
   std::string error;
   ASSERT_TRUE(decode_tile_result(encode_tile_result(in), out, error)) << error;
@@ -170,9 +170,9 @@ TEST(TileResult, AovSumsRoundTripAndVersionThreeIsRead) {
   std::memcpy(bad.data() + count_at, &wrong, 8);
   EXPECT_FALSE(decode_tile_result(bad, out, error));
 
-  // Version 3: the same without the AOV block (and its checksum over those bytes).
+  // Version 3: the same without the AOV block and the state's (and its checksum over those bytes).
   std::string v3 = encode_tile_result(sample_result(), kUncompressed);
-  v3.erase(v3.size() - kTileResultDigestBytes - 8);
+  v3.erase(v3.size() - kTileResultDigestBytes - 16);
   const uint32_t version = 3;
   std::memcpy(v3.data() + 4, &version, 4);
   XXH128_canonical_t c;
@@ -180,6 +180,34 @@ TEST(TileResult, AovSumsRoundTripAndVersionThreeIsRead) {
   v3.append(reinterpret_cast<const char*>(c.digest), sizeof(c.digest));
   ASSERT_TRUE(decode_tile_result(v3, out, error)) << error;
   EXPECT_FALSE(out.film.has_aovs());
+  EXPECT_TRUE(same_result(sample_result(), out));
+}
+
+// An sppm gather's result carries its pixels' state (format version 5); version 4 results, without
+// it, are still read; a state larger than its bound per pixel is refused.
+TEST(TileResult, TileStateRoundTripsAndVersionFourIsRead) {
+  TileResult in = sample_result();
+  in.tile_state.resize(13 * 9 * 32);
+  for (size_t i = 0; i < in.tile_state.size(); ++i) in.tile_state[i] = char(i * 7);
+  TileResult out;
+  std::string error;
+  ASSERT_TRUE(decode_tile_result(encode_tile_result(in), out, error)) << error;
+  EXPECT_EQ(out.tile_state, in.tile_state);
+  EXPECT_TRUE(same_result(in, out));
+
+  TileResult huge = sample_result();
+  huge.tile_state.assign(13 * 9 * (kMaxStateBytesPerPixel + 1), 'x');
+  EXPECT_FALSE(decode_tile_result(encode_tile_result(huge), out, error));
+
+  std::string v4 = encode_tile_result(sample_result(), kUncompressed);
+  v4.erase(v4.size() - kTileResultDigestBytes - 8);
+  const uint32_t version = 4;
+  std::memcpy(v4.data() + 4, &version, 4);
+  XXH128_canonical_t c;
+  XXH128_canonicalFromHash(&c, XXH3_128bits(v4.data(), v4.size()));
+  v4.append(reinterpret_cast<const char*>(c.digest), sizeof(c.digest));
+  ASSERT_TRUE(decode_tile_result(v4, out, error)) << error;
+  EXPECT_TRUE(out.tile_state.empty());
   EXPECT_TRUE(same_result(sample_result(), out));
 }
 

@@ -32,8 +32,8 @@ Command add_cancel_command(CLI::App& app);
 /// --server, --token-file and --ca-file: how every farm command reaches its coordinator.
 void add_connection_options(CLI::App& command, ConnectionOptions& connection);
 /// --integrator (render, submit, bench convergence): the scene's integrator replaced by one of
-/// Tessera's; with `farm`, one the farm runs.
-void add_integrator_option(CLI::App& command, std::string& integrator, bool farm = false);
+/// Tessera's (the farm runs every one).
+void add_integrator_option(CLI::App& command, std::string& integrator);
 /// "-D name=value" options into `out`; false, with the message printed as `who`'s, on a bad one.
 bool parse_defines(const std::vector<std::string>& given, std::map<std::string, std::string>& out, const char* who);
 
