@@ -47,6 +47,7 @@ json to_json(const JobStatus& s) {
   j["denoise_error"] = s.denoise_error.empty() ? json(nullptr) : json(s.denoise_error);
   j["guide"] = s.guide ? json{{"iterations", s.guide->iterations}, {"leaves", s.guide->leaves}, {"bytes", s.guide->bytes}}
                        : json(nullptr);
+  j["point_map"] = s.point_map ? json{{"iterations", s.point_map->iterations}, {"bytes", s.point_map->bytes}} : json(nullptr);
   // (Left out rather than null when the lease log could not be read, as before.)
   if (s.leases_issued) j["leases_issued"] = *s.leases_issued;
   if (s.max_leases_per_unit) j["max_leases_per_unit"] = *s.max_leases_per_unit;

@@ -338,6 +338,7 @@ JobStatus Coordinator::Impl::status_of(const JobState& job) {
   s.spp_done = job.spp_complete();
   s.stopped_at_target = job.converged();
   if (const GuideTraining* g = job.guide()) s.guide = JobStatus::Guide{job.guide_iterations(), g->tree_leaves(), g->tree_bytes()};
+  if (p.points) s.point_map = JobStatus::PointMap{job.sequencer().artifacts_stored(), job.latest_map_bytes};
   return s;
 }
 

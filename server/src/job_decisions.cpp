@@ -64,7 +64,10 @@ void Coordinator::Impl::save_artifacts(JobState& job) {
         spent_written = it->second;
         job.artifacts_written.erase(it);
       }
-      if (job.plan().points) job.artifacts_written[made.iteration] = written;
+      if (job.plan().points) {
+        job.artifacts_written[made.iteration] = written;
+        job.latest_map_bytes = made.artifact->memory_bytes();
+      }
       (void)commits.append(
           [id, iteration = made.iteration, hash, fed_before = job.first_pass_feeding_after(made.iteration),
            spent = spent.has_value()](Store& st) {

@@ -257,6 +257,7 @@ class JobState {
   // A point-map job's stored maps not yet spent: when their files were written (a spent map's file
   // is removed only if no one wrote it since).
   std::map<uint32_t, std::filesystem::file_time_type> artifacts_written;
+  uint64_t latest_map_bytes = 0;  // the latest stored point map's records (job status)
 
  private:
   Checkpoint film_checkpoint(uint32_t tile) const;

@@ -56,6 +56,9 @@ TEST(LightVertexFarm, TwoWorkersGiveTheLocalImage) {
     ASSERT_GT(id, 0u) << integrator;
     const nlohmann::json st = farm.wait_job(id, 200);
     ASSERT_EQ(st.value("state", ""), "done") << st.dump();
+    ASSERT_TRUE(st["point_map"].is_object()) << st.dump();
+    EXPECT_EQ(st["point_map"].value("iterations", 0), 5) << "a map per pass";
+    EXPECT_GT(st["point_map"].value("bytes", 0), 0);
     const Image local = local_render(scene, s);
     EXPECT_EQ(differing_pixels(farm.image(id), local), 0) << (*integrator ? integrator : "sppm");
     double sum = 0;

@@ -197,6 +197,28 @@ TEST(Protocol, LeaseRoundTripAndCacheKey) {
   bad = to_json(l);
   bad["first"][0] = 4294967290u;
   EXPECT_FALSE(lease_from_json(bad, back, error));
+  // An sppm gather's lease: its tile's per-pixel state, any bytes, base64 on the wire.
+  Lease gather = l;
+  gather.samples = {};
+  gather.tile_state = std::string("\0\x01\xff state", 9) + std::string(100, '\x7f');
+  error.clear();
+  Lease gather_back;
+  ASSERT_TRUE(lease_from_json(to_json(gather), gather_back, error)) << error;
+  EXPECT_EQ(gather_back.tile_state, gather.tile_state);
+  bad = to_json(gather);
+  bad["tile_state"] = "not base64!";
+  EXPECT_FALSE(lease_from_json(bad, gather_back, error));
+  // A photon pass's lease: paths, and no pixel samples of its own.
+  Lease photons = l;
+  photons.samples = {};
+  photons.paths = std::pair<uint64_t, uint64_t>{0, 4096};
+  photons.sample_end = photons.sample_begin;
+  error.clear();
+  Lease photons_back;
+  ASSERT_TRUE(lease_from_json(to_json(photons), photons_back, error)) << error;
+  bad = to_json(photons);
+  bad["tile_state"] = "AAAA";
+  EXPECT_FALSE(lease_from_json(bad, photons_back, error)) << "state only on a lease of a tile";
   // The cache key changes with anything that changes the loaded scene, not with the seed.
   JobSettings a = l.settings, b = a;
   b.seed = 99;
@@ -225,6 +247,7 @@ TEST(Protocol, LeaseBytesCountedFromTheJobPartAreExact) {
     l.sample_begin = 3;
     l.sample_end = uint32_t(id % 77) + 4;
     l.seconds_to_expiry = id == 1 ? 15.0 : 7.25;
+    if (id == 99) l.tile_state = std::string(size_t(id), 's');  // (an sppm gather's)
     EXPECT_EQ(lease_json_bytes(l, job_part), to_json(l).dump().size()) << id;
   }
 }

@@ -11,6 +11,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstring>
 #include <numeric>
 #include <random>
 #include <set>
@@ -322,6 +324,79 @@ TEST(PassSequencer, APhotonPassFeedsTheGatherAfterIt) {
   const UnitWork next = seq.work(seq.unit(3, 1));
   ASSERT_NE(next.tile_state, nullptr);
   EXPECT_EQ(*next.tile_state, "state of tile 1") << "across the photon pass between the gathers";
+}
+
+// A coordinator keeps a pass's records, never their grid (PointMapUse::Store), whatever order its
+// units arrive in; the bytes it stores decode to the grid a local render builds from them.
+TEST(PassSequencer, AStoredPhotonMapIsTheGridARenderBuilds) {
+  PassProgram p = photon_program(1, 120);
+  p.paths_per_unit = 50;
+  auto radius = [](uint32_t) { return 0.25f; };
+  PassSequencer local(p, test::toy_frame(8), std::make_unique<GridBuilder<Photon>>(radius));
+  PassSequencer farm(p, test::toy_frame(8), std::make_unique<GridBuilder<Photon>>(radius, PointMapUse::Store));
+  auto photons_of = [](uint32_t unit) {
+    std::vector<Photon> out;
+    for (uint32_t k = 0; k < 3 + unit; ++k)
+      out.push_back(Photon{{float(unit) * 0.3f, float(k) * 0.2f, 0.f}, {1.f, float(k), 0.5f}, k, {0, 0}, 2});
+    return out;
+  };
+  for (uint32_t i : {0u, 1u, 2u}) {
+    UnitResult r;
+    r.splats.reset(local.frame().window);
+    r.records = grid_records(photons_of(i));
+    ASSERT_TRUE(local.add_result(local.unit(0, i), std::move(r)));
+  }
+  for (uint32_t i : {2u, 0u, 1u}) {  // (another order)
+    UnitResult r;
+    r.splats.reset(farm.frame().window);
+    r.records = grid_records(photons_of(i));
+    std::string error;
+    ASSERT_TRUE(farm.check_records(farm.unit(0, i), r.records, error)) << error;
+    ASSERT_TRUE(farm.add_result(farm.unit(0, i), std::move(r)));
+  }
+  const auto rendered = local.take_artifact(), stored = farm.take_artifact();
+  ASSERT_TRUE(rendered && stored);
+  EXPECT_NE(dynamic_cast<const PointRecordsArtifact*>(stored->artifact.get()), nullptr) << "records, not a grid";
+  std::string error;
+  const auto decoded = decode_point_map(IntegratorType::Sppm, stored->artifact->encode(), error);
+  ASSERT_TRUE(decoded) << error;
+  const auto& a = static_cast<const PhotonMapArtifact*>(rendered->artifact.get())->grid();
+  const auto& b = static_cast<const PhotonMapArtifact*>(decoded.get())->grid();
+  EXPECT_EQ(a.max_radius(), b.max_radius());
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_EQ(std::memcmp(a.records().data(), b.records().data(), a.size() * sizeof(Photon)), 0);
+  // A record that is not finite is refused where records arrive, and by decode.
+  std::vector<Photon> bad = photons_of(0);
+  bad[1].power[0] = std::nanf("");
+  EXPECT_FALSE(check_point_records(IntegratorType::Sppm, grid_records(bad), error));
+  EXPECT_FALSE(check_point_records(IntegratorType::Sppm, "12345", error)) << "not whole records";
+  EXPECT_FALSE(decode_point_map(IntegratorType::Sppm, PointRecordsArtifact(0.25f, {grid_records(bad)}).encode(), error));
+}
+
+// Only each tile's latest per-pixel state is kept; a checkpoint restores it for the next gather.
+TEST(PassSequencer, OnlyATilesLatestStateIsKeptAndARestoreSetsIt) {
+  PassProgram p = photon_program(3, 60);
+  p.paths_per_unit = 60;
+  PassSequencer seq(p, test::toy_frame(8), std::make_unique<GridBuilder<Photon>>([](uint32_t) { return 0.5f; }));
+  auto run_pass = [&](uint32_t k) {
+    UnitResult photons;
+    photons.splats.reset(seq.frame().window);
+    ASSERT_TRUE(seq.add_result(seq.unit(2 * k, 0), std::move(photons)));
+    (void)seq.take_artifact();
+    seq.artifact_stored(k, "h" + std::to_string(k));
+    for (uint32_t t = 0; t < seq.num_tiles(); ++t) {
+      UnitResult gathered;
+      gathered.tile.reset(seq.tiles()[t]);
+      gathered.tile_state = "pass " + std::to_string(k) + " tile " + std::to_string(t);
+      ASSERT_TRUE(seq.add_result(seq.unit(2 * k + 1, t), std::move(gathered)));
+    }
+  };
+  run_pass(0);
+  run_pass(1);
+  EXPECT_EQ(seq.tile_state(1, 4), "pass 1 tile 1") << "the latest Tile pass before pass 4";
+  EXPECT_EQ(seq.tile_state(1, 3), "") << "pass 0's gather's, spent by pass 1's";
+  seq.restore_tile_state(1, 4, "restored");
+  EXPECT_EQ(*seq.work(seq.unit(5, 1)).tile_state, "restored");
 }
 
 }  // namespace

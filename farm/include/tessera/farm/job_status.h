@@ -45,6 +45,13 @@ struct JobStatus {
     uint64_t leaves = 0, bytes = 0;
   };
   std::optional<Guide> guide;
+  /// An sppm or vcm job's point maps: maps stored so far (one per pass), and the latest one's
+  /// records in bytes (what a worker holds of it, before its grid's index).
+  struct PointMap {
+    uint32_t iterations = 0;
+    uint64_t bytes = 0;
+  };
+  std::optional<PointMap> point_map;
   /// A denoised job's images (settings.denoise): "waiting" for its units, "running" (the raw image
   /// and the denoised one being made), "done", or "failed" with the reason in denoise_error (the
   /// job is done with its raw image).
