@@ -102,6 +102,17 @@ std::string zstd_frame(std::string_view raw) {
   return out;
 }
 
+// Uncompressed bytes as an older `version` wrote them: without the last `cut` bytes before the
+// checksum (the sections that version lacks), with its number and its XXH3-128 checksum.
+std::string as_older_version(std::string raw, uint32_t version, size_t cut) {
+  raw.erase(raw.size() - kTileResultDigestBytes - cut);
+  std::memcpy(raw.data() + 4, &version, 4);
+  XXH128_canonical_t c;
+  XXH128_canonicalFromHash(&c, XXH3_128bits(raw.data(), raw.size()));
+  raw.append(reinterpret_cast<const char*>(c.digest), sizeof(c.digest));
+  return raw;
+}
+
 TEST(TileResult, StoredUncompressedRoundTripsAndIsChecked) {
   const TileResult in = sample_result();
   const std::string raw = encode_tile_result(in, kUncompressed);
@@ -171,13 +182,7 @@ TEST(TileResult, AovSumsRoundTripAndVersionThreeIsRead) {
   EXPECT_FALSE(decode_tile_result(bad, out, error));
 
   // Version 3: the same without the AOV block and the state's (and its checksum over those bytes).
-  std::string v3 = encode_tile_result(sample_result(), kUncompressed);
-  v3.erase(v3.size() - kTileResultDigestBytes - 16);
-  const uint32_t version = 3;
-  std::memcpy(v3.data() + 4, &version, 4);
-  XXH128_canonical_t c;
-  XXH128_canonicalFromHash(&c, XXH3_128bits(v3.data(), v3.size()));
-  v3.append(reinterpret_cast<const char*>(c.digest), sizeof(c.digest));
+  const std::string v3 = as_older_version(encode_tile_result(sample_result(), kUncompressed), 3, 16);
   ASSERT_TRUE(decode_tile_result(v3, out, error)) << error;
   EXPECT_FALSE(out.film.has_aovs());
   EXPECT_TRUE(same_result(sample_result(), out));
@@ -199,13 +204,7 @@ TEST(TileResult, TileStateRoundTripsAndVersionFourIsRead) {
   huge.tile_state.assign(13 * 9 * (kMaxStateBytesPerPixel + 1), 'x');
   EXPECT_FALSE(decode_tile_result(encode_tile_result(huge), out, error));
 
-  std::string v4 = encode_tile_result(sample_result(), kUncompressed);
-  v4.erase(v4.size() - kTileResultDigestBytes - 8);
-  const uint32_t version = 4;
-  std::memcpy(v4.data() + 4, &version, 4);
-  XXH128_canonical_t c;
-  XXH128_canonicalFromHash(&c, XXH3_128bits(v4.data(), v4.size()));
-  v4.append(reinterpret_cast<const char*>(c.digest), sizeof(c.digest));
+  const std::string v4 = as_older_version(encode_tile_result(sample_result(), kUncompressed), 4, 8);
   ASSERT_TRUE(decode_tile_result(v4, out, error)) << error;
   EXPECT_TRUE(out.tile_state.empty());
   EXPECT_TRUE(same_result(sample_result(), out));
