@@ -88,6 +88,16 @@ PassSpec pass(UnitKind kind, uint32_t k, uint32_t samples) {
   return p;
 }
 
+// Iteration k of a program of point maps: `paths` feeds map k, then `tile`, a barrier, renders
+// with it.
+void add_map_iteration(PassProgram& program, uint32_t k, PassSpec paths, PassSpec tile) {
+  paths.feeds = k;
+  tile.barrier = true;
+  tile.uses = k;
+  program.passes.push_back(paths);
+  program.passes.push_back(tile);
+}
+
 }  // namespace
 
 uint32_t sppm_passes(const IntegratorSettings& settings, uint32_t spp) {
@@ -103,13 +113,9 @@ PassProgram photon_program(uint32_t passes, uint64_t photons) {
     PassSpec trace = pass(UnitKind::Paths, k, 0);
     trace.photons = photons;
     trace.film = kNoFilm;
-    trace.feeds = k;
     PassSpec gather = pass(UnitKind::Tile, k, 1);
-    gather.barrier = true;
-    gather.uses = k;
     gather.tile_state = k > 0;
-    program.passes.push_back(trace);
-    program.passes.push_back(gather);
+    add_map_iteration(program, k, trace, gather);
   }
   return program;
 }
@@ -121,12 +127,7 @@ PassProgram vcm_program(uint32_t spp, uint64_t window_pixels) {
   for (uint32_t k = 0; k < spp; ++k) {
     PassSpec light = pass(UnitKind::Paths, k, 1);
     light.same_samples = true;
-    light.feeds = k;
-    PassSpec camera = pass(UnitKind::Tile, k, 1);
-    camera.barrier = true;
-    camera.uses = k;
-    program.passes.push_back(light);
-    program.passes.push_back(camera);
+    add_map_iteration(program, k, light, pass(UnitKind::Tile, k, 1));
   }
   return program;
 }
