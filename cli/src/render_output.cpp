@@ -4,6 +4,7 @@
 #include "tessera/image/image.h"
 #include "tessera/render/shape.h"
 #include "tessera/sequence/path_program.h"
+#include "tessera/sequence/photon_program.h"
 #include "tessera/texture/bitmap.h"
 
 #include <algorithm>
@@ -118,6 +119,10 @@ void print_render_report(const RenderOptions& options, const Scene& scene, const
   if (stats.guide_leaves > 0)
     std::fprintf(stderr, "guide: %zu spatial leaves, %.1f MB (cap %.0f MB)\n", stats.guide_leaves,
                  double(stats.guide_bytes) / 1e6, double(guide_plan(scene, settings.guiding)->settings.max_bytes) / 1e6);
+  if (const std::optional<PointMapPlan> points = point_map_plan(scene))
+    std::fprintf(stderr, "%s: initial radius %.4g (%s), alpha %.3g\n", integrator_name(points->type),
+                 double(points->initial_radius), scene.integrator.initial_radius > 0.f ? "the scene's" : "automatic",
+                 double(points->alpha));
   if (const EmissionPortal& portal = scene.emission_portal(); portal.active())
     std::fprintf(stderr, "emission portal: %d boxes from %u escapes of %u pilot camera paths\n", portal.box_count(),
                  portal.escapes(), EmissionPortal::kPilotPaths);

@@ -52,12 +52,67 @@ TEST(Vcm, WithoutMergingIsBdptBitForBit) {
   EXPECT_TRUE(same_image(a, b)) << "the image, light tracing's splats included";
 }
 
+// Metal of alpha 0.3 everywhere, the emitters too (smoother than merge_roughness 0.5), lit by a
+// sphere and a quad.
+const char* kGlossyScene = R"(<scene version="3.0.0">
+  <integrator type="path"><integer name="max_depth" value="5"/></integrator>
+  <sensor type="perspective"><float name="fov" value="55"/>
+    <transform name="to_world"><lookat origin="0,1.2,4.5" target="0,0.6,0" up="0,1,0"/></transform>
+    <sampler type="independent"/>
+    <film type="hdrfilm"><integer name="width" value="24"/><integer name="height" value="18"/><rfilter type="box"/></film>
+  </sensor>
+  <bsdf type="roughconductor" id="metal"><float name="alpha" value="0.3"/></bsdf>
+  <shape type="rectangle"><transform name="to_world"><scale value="3"/><rotate x="1" angle="-90"/></transform><ref id="metal"/></shape>
+  <shape type="rectangle"><transform name="to_world"><scale value="3"/><translate z="-2"/></transform><ref id="metal"/></shape>
+  <shape type="sphere"><point name="center" x="0.4" y="0.45" z="0.4"/><float name="radius" value="0.45"/><ref id="metal"/></shape>
+  <shape type="sphere"><point name="center" x="0.8" y="2.2" z="-0.5"/><float name="radius" value="0.25"/>
+    <ref id="metal"/><emitter type="area"><rgb name="radiance" value="12,10,8"/></emitter></shape>
+  <shape type="rectangle"><transform name="to_world"><scale value="0.5"/><rotate x="1" angle="90"/>
+    <translate x="-0.8" y="2.5" z="0.2"/></transform><ref id="metal"/><emitter type="area"><rgb name="radiance" value="4,4,5"/></emitter></shape>
+</scene>)";
+
+// Where the rules leave no merge, every merge term is gone from every weight: bdpt's image, bit
+// for bit (its pixel sums are taken in another order: vcm's program has a pass per iteration). Paths
+// of at most two segments have only direct light (merge_direct false); a scene of metal smoother
+// than merge_roughness has no vertex that merges.
+TEST(Vcm, WhereNoVertexMergesItIsBdptBitForBit) {
+  for (const int max_depth : {1, 2}) {
+    auto bdpt = load_as(kMixedScene, "bdpt");
+    auto vcm = load_as(kMixedScene, "vcm");
+    for (Scene* s : {bdpt.get(), vcm.get()}) s->integrator.max_depth = max_depth;
+    vcm->integrator.initial_radius = 0.3f;
+    EXPECT_TRUE(same_image(render(*bdpt, render_settings(4, 3)), render(*vcm, render_settings(4, 3))))
+        << "direct light only, max_depth " << max_depth;
+  }
+  const auto bdpt = load_as(kGlossyScene, "bdpt");
+  auto vcm = load_as(kGlossyScene, "vcm");
+  vcm->integrator.initial_radius = 0.3f;
+  vcm->integrator.merge_roughness = 0.5f;
+  const Film a = render(*bdpt, render_settings(4, 3)), b = render(*vcm, render_settings(4, 3));
+  EXPECT_TRUE(same_image(a, b)) << "no surface rough enough to merge";
+  vcm->integrator.merge_roughness = 0.2f;
+  EXPECT_FALSE(same_image(a, render(*vcm, render_settings(4, 3)))) << "rough enough to merge: not bdpt";
+}
+
+// SmallVCM's merges (everywhere, direct light too), the defaults (no direct light), and only
+// where the BSDF is rough (merge_roughness 0.5: the rough metal sphere, alpha 0.15, neither
+// merges nor counts merges in its strategies' weights) all converge to the path tracer's image.
 TEST(Vcm, ConvergesToPathOnTheMixedScene) {
   const Estimate path = estimate(*load_as(kMixedScene, "path"), 64, 16, 8, 100);
-  auto vcm = load_as(kMixedScene, "vcm");
-  vcm->integrator.initial_radius = 0.1f;
-  const Estimate merged = estimate(*vcm, 16, 16, 8, 200);
-  expect_agree(merged, path, 6.0, "vcm vs path (mixed)");
+  struct Rules {
+    float merge_roughness;
+    bool merge_direct;
+  };
+  for (const Rules rules : {Rules{0.f, true}, Rules{0.1f, false}, Rules{0.5f, false}}) {
+    auto vcm = load_as(kMixedScene, "vcm");
+    vcm->integrator.initial_radius = 0.1f;
+    vcm->integrator.merge_roughness = rules.merge_roughness;
+    vcm->integrator.merge_direct = rules.merge_direct;
+    const Estimate merged = estimate(*vcm, 16, 16, 8, 200);
+    expect_agree(merged, path, 6.0,
+                 "vcm vs path (mixed), merge_roughness " + std::to_string(rules.merge_roughness) + ", merge_direct " +
+                     (rules.merge_direct ? "true" : "false"));
+  }
 }
 
 // Photon mapping (no connections) and sppm converge to the same image, caustic included; at a

@@ -81,6 +81,27 @@ TEST(BidirectionalLoader, BadValuesNameFileLineAndParameter) {
   EXPECT_NE(hide.find("mem/bidir.xml:3: parameter 'hideEmitters' of integrator 'bdpt'"), std::string::npos) << hide;
 }
 
+// vcm's rules for where merges happen: defaults (no direct light, only rough surfaces), values,
+// and a roughness outside [0, 1] named with its file and line.
+TEST(BidirectionalLoader, VcmReadsWhereItMerges) {
+  const IntegratorSettings d = load("<integrator type=\"vcm\"/>").scene->integrator;
+  EXPECT_EQ(d.type, IntegratorType::Vcm);
+  EXPECT_FALSE(d.merge_direct);
+  EXPECT_FLOAT_EQ(d.merge_roughness, 0.1f);
+  LoadResult r = load(R"(<integrator type="vcm">
+<boolean name="merge_direct" value="true"/>
+<float name="merge_roughness" value="0"/>
+</integrator>)");
+  EXPECT_TRUE(r.scene->integrator.merge_direct);
+  EXPECT_EQ(r.scene->integrator.merge_roughness, 0.f);
+  EXPECT_TRUE(r.unsupported.empty());
+  const std::string rough = scene_error_of([] {
+    load("<integrator type=\"vcm\">\n<float name=\"merge_roughness\" value=\"1.5\"/>\n</integrator>");
+  });
+  EXPECT_NE(rough.find("mem/bidir.xml:3: 'merge_roughness' of integrator 'vcm' must be in [0, 1]"), std::string::npos)
+      << rough;
+}
+
 TEST(BidirectionalLoader, PtracerNotesSchedulingAndReportsBruteForce) {
   LoadResult r = load(R"(<integrator type="ptracer">
 <integer name="maxDepth" value="6"/>

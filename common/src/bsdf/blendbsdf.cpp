@@ -68,6 +68,10 @@ class BlendBsdf final : public Bsdf {
   }
 
   bool is_delta() const override { return bsdfs_[0]->is_delta() && bsdfs_[1]->is_delta(); }
+  float roughness(const SurfaceInteraction& si) const override {
+    const float w = weight(si);
+    return std::max(w < 1.f ? bsdfs_[0]->roughness(si) : 0.f, w > 0.f ? bsdfs_[1]->roughness(si) : 0.f);
+  }
   bool has_opacity() const override { return bsdfs_[0]->has_opacity() || bsdfs_[1]->has_opacity(); }
   float opacity(const SurfaceInteraction& si) const override {
     const float w = weight(si);

@@ -113,6 +113,7 @@ class CoatingBsdf final : public Bsdf {
   }
 
   bool is_delta() const override { return nested_->is_delta(); }
+  float roughness(const SurfaceInteraction& si) const override { return nested_->roughness(si); }
   bool has_opacity() const override { return nested_->has_opacity(); }
   float opacity(const SurfaceInteraction& si) const override { return nested_->opacity(si); }
 

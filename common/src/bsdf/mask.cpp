@@ -27,6 +27,7 @@ class MaskBsdf final : public Bsdf {
     return nested_->sample(si, wo, u1, u2, out);
   }
   bool is_delta() const override { return nested_->is_delta(); }
+  float roughness(const SurfaceInteraction& si) const override { return nested_->roughness(si); }
   bool has_opacity() const override { return true; }
 
   float opacity(const SurfaceInteraction& si) const override {

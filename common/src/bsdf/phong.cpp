@@ -75,6 +75,12 @@ class PhongBsdf final : public Bsdf {
     return true;
   }
 
+  // (A Phong lobe of exponent n is about as wide as a Beckmann lobe of alpha sqrt(2 / (n + 2)).)
+  float roughness(const SurfaceInteraction& si) const override {
+    if (specular_weight_ < 1.f) return 1.f;
+    return std::clamp(std::sqrt(2.f / (std::max(exponent_->eval_1(si), 0.f) + 2.f)), 0.f, 1.f);
+  }
+
  private:
   static Vec3 reflect(Vec3 w) { return {-w.x, -w.y, w.z}; }
 

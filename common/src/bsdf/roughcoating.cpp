@@ -121,6 +121,9 @@ class RoughCoatingBsdf final : public Bsdf {
 
   bool has_opacity() const override { return nested_->has_opacity(); }
   float opacity(const SurfaceInteraction& si) const override { return nested_->opacity(si); }
+  float roughness(const SurfaceInteraction& si) const override {
+    return std::max(std::clamp(alpha_->eval_1(si), 0.f, 1.f), nested_->roughness(si));
+  }
 
  private:
   float prob_specular(Vec3 wo, float alpha) const {

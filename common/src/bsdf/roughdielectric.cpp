@@ -17,6 +17,7 @@
 #include "tessera/core/frame.h"
 #include "tessera/scene/load_context.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace tessera {
@@ -124,6 +125,11 @@ class RoughDielectricBsdf final : public Bsdf {
     out.weight = weight * ratio;
     out.delta = false;
     return true;
+  }
+
+  float roughness(const SurfaceInteraction& si) const override {
+    const float au = alpha_u_->eval_1(si);
+    return std::clamp(alpha_v_ ? std::min(au, alpha_v_->eval_1(si)) : au, 0.f, 1.f);
   }
 
  private:

@@ -34,6 +34,9 @@ class TwoSidedBsdf final : public Bsdf {
   }
 
   bool is_delta() const override { return front_->is_delta() && back_->is_delta(); }
+  float roughness(const SurfaceInteraction& si) const override {
+    return dot(si.wo, si.shading.n) < 0.f ? back_->roughness(si) : front_->roughness(si);
+  }
   bool has_opacity() const override { return front_->has_opacity() || back_->has_opacity(); }
   float opacity(const SurfaceInteraction& si) const override {
     return dot(si.wo, si.shading.n) < 0.f ? back_->opacity(si) : front_->opacity(si);

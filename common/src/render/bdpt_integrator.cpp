@@ -20,6 +20,9 @@ struct CameraPath {
   float eta = 1.f;
   int length = 1;  // segments up to the vertex being visited
   float d_vcm = 0.f, d_vc = 0.f, d_vm = 0.f;
+  // d_vc without the previous vertex's merge: for s = 0, where that merge would be of direct light
+  // (MisWeights::merge_direct off); d_vc itself otherwise, and with merging off.
+  float d_vc_direct = 0.f;
   LightSampleContext prev_ctx;
   float time = 0.f;
   bool specular = true;  // every vertex so far was delta (vcm's photon mapping mode)
@@ -29,7 +32,9 @@ struct CameraPath {
 struct CameraVertex {
   const SurfaceInteraction* si;
   const Bsdf* bsdf;
-  Vec3 wo;  // local
+  Vec3 wo;          // local
+  float merges;     // bdpt::merges_at
+  float vm;         // MisWeights::vm times merges
 };
 
 // bdpt, and vcm's camera half (vcm.h) when an iteration to merge with is given.
@@ -64,6 +69,7 @@ class BdptIntegrator final : public Integrator {
       const float inv = cos_in > 0.f ? 1.f / mis(cos_in) : 0.f;
       c.d_vcm *= mis(dist * dist) * inv;
       c.d_vc *= inv;
+      c.d_vc_direct *= inv;
       c.d_vm *= inv;
       if (const Light* area = si.area_light(); area && (connect_ || c.specular))
         L += c.beta * emission(scene, c, si, *area, wo_world, dist);
@@ -71,13 +77,14 @@ class BdptIntegrator final : public Integrator {
       if (!reconcile_shading_frame(si, wo_world, s_.strict_normals)) break;
       const Bsdf* bsdf = si.bsdf();
       if (!bsdf) break;
-      const CameraVertex v{&si, bsdf, si.to_local(wo_world)};
+      const float merges = bsdf->is_delta() ? 0.f : bdpt::merges_at(mw_, *bsdf, si);
+      const CameraVertex v{&si, bsdf, si.to_local(wo_world), merges, mw_.vm * merges};
       const BounceSamples u = BounceSamples::draw(sampler);
       if (!bsdf->is_delta()) {
         if (connect_ && s_.sample_direct && (s_.max_depth < 0 || c.length + 1 <= s_.max_depth))
           L += c.beta * direct(scene, c, v, u, counters);
         L += c.beta * connect(scene, c, v, light, counters);
-        if (merge_) L += c.beta * merge(c, v);
+        if (merge_ && merges > 0.f) L += c.beta * merge(c, v);
         if (!connect_) break;  // (photon mapping: the first non-delta vertex merges everything)
       }
       if (!scatter(c, v, u, ray)) break;
@@ -102,7 +109,7 @@ class BdptIntegrator final : public Integrator {
     float pdf_pos = 0.f, pdf_dir = 0.f;
     bdpt::emission_pdfs(scene, area, si.p, si.ng, wo_world, si.p, pdf_pos, pdf_dir);
     const float emission_pdf = scene.light_sampler().emitter_pmf(&area) * pdf_pos * pdf_dir;
-    const float w = mis(direct_a) * c.d_vcm + mis(emission_pdf) * c.d_vc;
+    const float w = mis(direct_a) * c.d_vcm + mis(emission_pdf) * c.d_vc_direct;
     return le * bdpt::strategy_weight(s_, 0, c.length + 1, 1.f / (1.f + w));
   }
 
@@ -120,7 +127,7 @@ class BdptIntegrator final : public Integrator {
       float pdf_pos = 0.f, pdf_dir = 0.f;
       bdpt::emission_pdfs(scene, *env, Vec3(0.f), Vec3(0.f), -d, c.prev_ctx.p, pdf_pos, pdf_dir);
       const float emission_pdf = scene.light_sampler().emitter_pmf(env) * pdf_pos * pdf_dir;
-      sum += le * bdpt::strategy_weight(s_, 0, c.length + 1, 1.f / (1.f + mis(direct_w) * c.d_vcm + mis(emission_pdf) * c.d_vc));
+      sum += le * bdpt::strategy_weight(s_, 0, c.length + 1, 1.f / (1.f + mis(direct_w) * c.d_vcm + mis(emission_pdf) * c.d_vc_direct));
     }
     return sum;
   }
@@ -150,7 +157,7 @@ class BdptIntegrator final : public Integrator {
     const float cos_to_light = std::abs(dot(si.ng, ls.wi));
     const float w_light = mis(pdf_fwd / (pmf * direct_w));
     const float w_camera = cos_at_light > 0.f ? mis(emission_w * cos_to_light / (pmf * direct_w * cos_at_light)) *
-                                                   (c.d_vcm + c.d_vc * mis(pdf_rev) + mw_.vm)
+                                                   (c.d_vcm + c.d_vc * mis(pdf_rev) + (mw_.merge_direct ? v.vm : 0.f))
                                              : 0.f;
     const float tr = bdpt::direct_transmittance(scene, si, ls, c.time, counters);
     if (!(tr > 0.f)) return {};
@@ -179,8 +186,8 @@ class BdptIntegrator final : public Integrator {
       const float pdf_c_fwd = v.bsdf->pdf(si, v.wo, wi), pdf_c_rev = v.bsdf->pdf(si, wi, v.wo);
       const float pdf_l_fwd = lv.bsdf->pdf(lv.si, lv.wo, wl), pdf_l_rev = lv.bsdf->pdf(lv.si, wl, lv.wo);
       const float cos_c = std::abs(dot(si.ng, dir)), cos_l = std::abs(dot(lv.si.ng, dir));
-      const float w_light = mis(pdf_c_fwd * cos_l / dist2) * (lv.d_vcm + lv.d_vc * mis(pdf_l_rev) + mw_.vm);
-      const float w_camera = mis(pdf_l_fwd * cos_c / dist2) * (c.d_vcm + c.d_vc * mis(pdf_c_rev) + mw_.vm);
+      const float w_light = mis(pdf_c_fwd * cos_l / dist2) * (lv.d_vcm + lv.d_vc * mis(pdf_l_rev) + lv.vm);
+      const float w_camera = mis(pdf_l_fwd * cos_c / dist2) * (c.d_vcm + c.d_vc * mis(pdf_c_rev) + v.vm);
       Ray shadow = spawn_ray_to(si, lv.si.p, lv.si.p_error, lv.si.ng);
       shadow.time = c.time;
       ++counters.shadow_rays;
@@ -202,12 +209,15 @@ class BdptIntegrator final : public Integrator {
     const float cos_out = std::abs(dot(si.ng, wi));
     if (bs.delta) {
       c.d_vc *= mis(cos_out);
+      c.d_vc_direct = c.d_vc;
       c.d_vm *= mis(cos_out);
       c.d_vcm = 0.f;
     } else {
       const float pdf_rev = v.bsdf->pdf(si, bs.wi, v.wo);
-      c.d_vc = mis(cos_out / bs.pdf) * (c.d_vc * mis(pdf_rev) + c.d_vcm + mw_.vm);
-      c.d_vm = mis(cos_out / bs.pdf) * (c.d_vm * mis(pdf_rev) + c.d_vcm * mw_.vc + 1.f);
+      const float d_vc = c.d_vc * mis(pdf_rev) + c.d_vcm;
+      c.d_vc = mis(cos_out / bs.pdf) * (d_vc + v.vm);
+      c.d_vc_direct = mw_.merge_direct ? c.d_vc : mis(cos_out / bs.pdf) * d_vc;
+      c.d_vm = mis(cos_out / bs.pdf) * (c.d_vm * mis(pdf_rev) + c.d_vcm * mw_.vc + v.merges);
       c.d_vcm = mis(1.f / bs.pdf);
       c.specular = false;
     }

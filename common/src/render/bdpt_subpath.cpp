@@ -140,6 +140,9 @@ void trace_light_subpath(const Scene& scene, const IntegratorSettings& s, Sample
     v.d_vcm = d_vcm;
     v.d_vc = d_vc;
     v.d_vm = d_vm;
+    const bool direct = len == 1;  // (a merge here would be direct light: merge_direct)
+    const float merges = bsdf->is_delta() || (direct && !mw.merge_direct) ? 0.f : merges_at(mw, *bsdf, v.si);
+    v.vm = mw.vm * merges;
     v.u_lens = sampler.next_2d();
     const float u_lobe = sampler.next_1d();
     const Vec2 u_dir = sampler.next_2d();
@@ -160,9 +163,9 @@ void trace_light_subpath(const Scene& scene, const IntegratorSettings& s, Sample
     } else {
       beta *= adjoint_eval(v.si, *bsdf, v.wo_world, wi) * (1.f / bs.pdf);
       const float pdf_rev = bsdf->pdf(v.si, bs.wi, v.wo);
-      // (Georgiev's updates; without merging, mw.vm is 0 and d_vc is bdpt's to the bit.)
-      d_vc = mis(cos_out / bs.pdf) * (d_vc * mis(pdf_rev) + d_vcm + mw.vm);
-      d_vm = mis(cos_out / bs.pdf) * (d_vm * mis(pdf_rev) + d_vcm * mw.vc + 1.f);
+      // (Georgiev's updates; without merging, v.vm is 0 and d_vc is bdpt's to the bit.)
+      d_vc = mis(cos_out / bs.pdf) * (d_vc * mis(pdf_rev) + d_vcm + v.vm);
+      d_vm = mis(cos_out / bs.pdf) * (d_vm * mis(pdf_rev) + d_vcm * mw.vc + merges);
       d_vcm = mis(1.f / bs.pdf);
     }
     if (!survives(s, len, beta, beta0, u_rr)) break;

@@ -33,16 +33,30 @@ inline float strategy_weight(const IntegratorSettings& settings, int s, int t, f
 }
 
 /// Vertex merging's MIS constants for one iteration: vm = mis(eta_vcm) when merging (0: off),
-/// vc = mis(1 / eta_vcm) when connecting.
+/// vc = mis(1 / eta_vcm) when connecting; merges only at vertices whose BSDF is at least
+/// min_roughness rough (Bsdf::roughness; 0: at every non-delta vertex).
+/// merge_direct: merges also with light vertices where the light first meets a surface.
 struct MisWeights {
   float vm = 0.f, vc = 0.f;
+  float min_roughness = 0.f;
+  bool merge_direct = true;
 };
 
-/// The constants of iteration `it` of a vcm render that merges (none for bdpt: radius 0).
+/// The constants of iteration `it` of a vcm render that merges (none for bdpt: radius 0). Without
+/// connections (photon mapping) the first non-delta camera vertex merges, however smooth.
 inline MisWeights vcm_weights(const IntegratorSettings& s, const VcmIteration& it) {
   if (!(it.radius > 0.f)) return {};
   const float eta = float(3.14159265358979323846 * double(it.radius) * double(it.radius) * it.light_paths);
-  return {s.merge ? mis(eta) : 0.f, s.connect ? mis(1.f / eta) : 0.f};
+  return {s.merge ? mis(eta) : 0.f, s.connect ? mis(1.f / eta) : 0.f, s.connect ? s.merge_roughness : 0.f,
+          s.merge_direct || !s.connect};
+}
+
+/// 1 when the iteration merges at a non-delta vertex of this BSDF, else 0. Where it does not, a
+/// merge there is no strategy, and its terms leave every other strategy's weight (the vm and 1
+/// of Georgiev's updates at that vertex), so the weights of a path's strategies still sum to 1.
+inline float merges_at(const MisWeights& mw, const Bsdf& bsdf, const SurfaceInteraction& si) {
+  if (!(mw.vm > 0.f)) return 0.f;
+  return mw.min_roughness <= 0.f || bsdf.roughness(si) >= mw.min_roughness ? 1.f : 0.f;
 }
 
 /// A merge (or a photon's gather) counts only where the surfaces face within about 60 degrees.
@@ -60,6 +74,7 @@ struct Vertex {
   Rgb beta;        // light: emitted power along the subpath; camera: throughput
   int length = 0;  // segments from the subpath's origin
   float d_vcm = 0.f, d_vc = 0.f, d_vm = 0.f;
+  float vm = 0.f;  // MisWeights::vm where the iteration merges at this vertex (merges_at), else 0
   Vec2 u_lens;     // light vertices: the lens sample of its camera connection
 };
 

@@ -68,7 +68,7 @@ namespace {
 
 // t = 1 at one light vertex: its importance from the camera, MIS-weighted (bdpt) against the
 // camera's subpath sampling this vertex (t >= 2).
-void connect_to_camera(const Scene& scene, const bdpt::Vertex& v, float time, bool weighted, float vm, LightSplats& out) {
+void connect_to_camera(const Scene& scene, const bdpt::Vertex& v, float time, bool weighted, LightSplats& out) {
   CameraSampleWi cs;
   if (!scene.camera->sample_wi(v.si.p, v.u_lens, time, cs) || !(cs.pdf > 0.f)) return;
   const Rgb f = adjoint_eval(v.si, *v.bsdf, v.wo_world, cs.wi);
@@ -81,7 +81,7 @@ void connect_to_camera(const Scene& scene, const bdpt::Vertex& v, float time, bo
     scene.camera->pdf_we(from_camera, pdf_pos, pdf_dir);
     const float camera_pdf_a = pdf_dir * std::abs(dot(v.si.ng, cs.wi)) / (cs.dist * cs.dist);
     const float pdf_rev = v.bsdf->pdf(v.si, v.si.to_local(cs.wi), v.wo);
-    w = 1.f / (1.f + bdpt::mis(camera_pdf_a) * (v.d_vcm + v.d_vc * bdpt::mis(pdf_rev) + vm));
+    w = 1.f / (1.f + bdpt::mis(camera_pdf_a) * (v.d_vcm + v.d_vc * bdpt::mis(pdf_rev) + v.vm));
   }
   Ray shadow = spawn_ray_to(v.si, cs.p_lens, Vec3(0.f), Vec3(0.f));
   shadow.time = time;
@@ -129,9 +129,8 @@ void trace_paths(const Scene& scene, const VcmIteration& it, uint64_t path_begin
     bdpt::trace_light_subpath(scene, s, sampler, time, light, out.counters, mw);
     for (const bdpt::Vertex& v : light.vertices) {
       if (s.max_depth >= 0 && v.length + 1 > s.max_depth) break;
-      if (records) records->push_back(vertex_record(v));
-      if (splats && bdpt::strategy_weight(s, v.length + 1, 1, 1.f) > 0.f)
-        connect_to_camera(scene, v, time, weighted, mw.vm, out);
+      if (records && v.vm > 0.f) records->push_back(vertex_record(v));  // (where merges happen)
+      if (splats && bdpt::strategy_weight(s, v.length + 1, 1, 1.f) > 0.f) connect_to_camera(scene, v, time, weighted, out);
     }
   }
 }

@@ -147,6 +147,8 @@ void read_vcm(const SceneNode& node, IntegratorSettings& s) {
   s.alpha = get_float_in(node, "alpha", 0.75f, 0.f, 1.f, true);
   s.merge = node.get_bool("merge", true);
   s.connect = node.get_bool("connect", true);
+  s.merge_roughness = get_float_in(node, "merge_roughness", s.merge_roughness, 0.f, 1.f, false);
+  s.merge_direct = node.get_bool("merge_direct", s.merge_direct);
   if (!s.merge && !s.connect)
     throw SceneError(node.loc, node.describe() + " with neither merge nor connect has no strategy to render with");
 }

@@ -69,8 +69,13 @@ struct IntegratorSettings {
   float initial_radius = 0.f;
   float alpha = 0.7f;
   int max_passes = -1;
-  // vcm: vertex merging and vertex connection (bdpt's strategies) on or off.
+  // vcm: vertex merging and vertex connection (bdpt's strategies) on or off; with both, merges
+  // only at vertices whose BSDF is at least merge_roughness rough (Bsdf::roughness) and, unless
+  // merge_direct, not with light vertices where the light first meets a surface (direct light,
+  // which next-event estimation and the connections render with less noise). vcm.h.
   bool merge = true, connect = true;
+  float merge_roughness = 0.1f;
+  bool merge_direct = false;
   // sppm, for tests and comparisons (never read from files): direct light at visible points from
   // photons too (photons of every length stored), as Mitsuba 0.6's sppm does, instead of
   // next-event estimation.

@@ -17,11 +17,23 @@
 // blur it: 10% too dark in the glass-caustic scene's blocks under a shadow edge.) Merges use
 // eta_vcm = pi r_k^2 N_L to convert between the two kinds of strategy (bdpt_subpath.h).
 //
+// Merges happen only where connections cannot do their work well, by two rules:
+// - not with light vertices where the light first meets a surface (unless merge_direct): that is
+//   direct light, which next-event estimation renders with less noise; a merge's count of light
+//   vertices within r_k is noisy, and its MIS weight, which grows with eta_vcm, ignores that;
+// - only at vertices whose BSDF is at least merge_roughness rough (Bsdf::roughness; 0: at every
+//   non-delta vertex): on a glossy surface a merge evaluates a narrow lobe with a direction from
+//   up to r_k away, so it blurs and is noisy where connections are sharp.
+// (With both off, merges are SmallVCM's.) Where a merge does not happen it is no strategy at all:
+// its terms leave the weights of every other strategy of the paths through that vertex (Georgiev's
+// recursion skips them there), so the weights still sum to one and the estimator stays
+// consistent. Only vertices that merge are kept in the light vertex map.
+//
 // merge = false: no merging, the same program and estimator as bdpt, bit for bit (its MIS terms
 // for merges are exactly zero). connect = false: progressive photon mapping as SmallVCM's "ppm"
 // mode has it: emitters only along purely specular camera paths, the first non-delta camera vertex
-// merges every light vertex (direct light too) with weight 1, no connections, no light tracing; it
-// converges to the image sppm converges to.
+// merges every light vertex (direct light too) with weight 1, however smooth (merge_roughness is
+// not read), no connections, no light tracing; it converges to the image sppm converges to.
 #pragma once
 
 #include "tessera/render/bdpt.h"
