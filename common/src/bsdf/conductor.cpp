@@ -31,7 +31,6 @@ class ConductorBsdf final : public Bsdf {
   }
 
   bool is_delta() const override { return true; }
-  float roughness(const SurfaceInteraction&) const override { return 0.f; }
 
  private:
   ConductorIor ior_;

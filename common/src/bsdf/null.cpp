@@ -20,7 +20,6 @@ class NullBsdf final : public Bsdf {
     return true;
   }
   bool is_delta() const override { return true; }
-  float roughness(const SurfaceInteraction&) const override { return 0.f; }
   bool has_opacity() const override { return true; }
   float opacity(const SurfaceInteraction&) const override { return 0.f; }
   bool is_null() const override { return true; }

@@ -17,7 +17,6 @@
 #include "tessera/core/frame.h"
 #include "tessera/scene/load_context.h"
 
-#include <algorithm>
 #include <cmath>
 
 namespace tessera {
@@ -127,10 +126,7 @@ class RoughDielectricBsdf final : public Bsdf {
     return true;
   }
 
-  float roughness(const SurfaceInteraction& si) const override {
-    const float au = alpha_u_->eval_1(si);
-    return std::clamp(alpha_v_ ? std::min(au, alpha_v_->eval_1(si)) : au, 0.f, 1.f);
-  }
+  float roughness(const SurfaceInteraction& si) const override { return distribution(si).roughness(); }
 
  private:
   /// Generalised half vector on +z; false for a degenerate or side-inconsistent configuration.

@@ -22,7 +22,6 @@ class ThinDielectricBsdf final : public Bsdf {
   Rgb eval(const SurfaceInteraction&, Vec3, Vec3) const override { return {}; }
   float pdf(const SurfaceInteraction&, Vec3, Vec3) const override { return 0.f; }
   bool is_delta() const override { return true; }
-  float roughness(const SurfaceInteraction&) const override { return 0.f; }
 
   bool sample(const SurfaceInteraction& si, Vec3 wo, float u1, Vec2, BsdfSample& out) const override {
     float r = fresnel_dielectric(abs_cos_theta(wo), eta_);

@@ -16,6 +16,7 @@
 
 #include "tessera/core/vec.h"
 
+#include <algorithm>
 #include <optional>
 #include <string_view>
 
@@ -42,6 +43,8 @@ class MicrofacetDistribution {
   float alpha_u() const { return alpha_u_; }
   float alpha_v() const { return alpha_v_; }
   bool is_isotropic() const { return alpha_u_ == alpha_v_; }
+  /// Bsdf::roughness of a lobe of this distribution: the smaller alpha, at most 1.
+  float roughness() const { return std::min(std::min(alpha_u_, alpha_v_), 1.f); }
   /// True when sample_m() draws visible normals (its pdf then depends on wi).
   bool samples_visible_normals() const { return type_ == MicrofacetType::Ggx; }
 

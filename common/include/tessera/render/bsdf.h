@@ -38,7 +38,7 @@ class Bsdf {
   /// How rough the roughest non-delta lobe is at `si`, in [0, 1]: 1 for a diffuse lobe, a
   /// microfacet lobe's alpha (the smaller of an anisotropic pair), 0 when every lobe is a delta.
   /// For strategies that pay only on rough surfaces (vcm's vertex merging, vcm.h).
-  virtual float roughness(const SurfaceInteraction&) const { return 1.f; }
+  virtual float roughness(const SurfaceInteraction&) const { return is_delta() ? 0.f : 1.f; }
   /// True when the BSDF (Mitsuba's `mask`, or a wrapper around one) lets part of the light pass
   /// straight through the surface. Wrappers (twosided, bumpmap, ...) must forward both methods.
   virtual bool has_opacity() const { return false; }
