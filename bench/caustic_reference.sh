@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# A reference for one of Tessera's own scenes (scenes/SCENE/scene.xml: pool, glass-caustic), which
-# have no Mitsuba reference in ../shared, made by two independent methods that must agree:
+# A reference for one of Tessera's own scenes (scenes/SCENE/scene.xml: pool, glass-caustic,
+# door-ajar, window-pane), which have no Mitsuba reference in ../shared, made by two independent
+# methods that must agree:
 #
-# 1. Method A, `sppm`: RENDERS independent renders of SPP_A passes (seeds 1001, 1002, ...) at the
+# 1. Method A, CR_METHOD_A (default `sppm`): RENDERS independent renders of SPP_A passes (seeds 1001, 1002, ...) at the
 #    scene's own resolution, averaged: OUT/SCENE/A/reference.exr (the mean), variance.exr (the
 #    variance of that mean per pixel: the renders' sample variance / RENDERS) and runs.csv (per
 #    render its seed, seconds and channel means).
@@ -30,7 +31,8 @@
 #
 # Usage: bench/caustic_reference.sh [BUILD_DIR] [SCENE] [RENDERS] [SPP_A] [SPP_B] [OUT]
 #        (defaults: build pool 8 256 256 out/references)
-# Environment: CR_THREADS=2  CR_METHOD_B=bdpt|vcm|path|volpath|ptracer (default above)
+# Environment: CR_THREADS=2  CR_METHOD_A, CR_METHOD_B: sppm|bdpt|vcm|path|volpath|ptracer (defaults
+#   above; not the same)
 #   CR_MAX_BLOCKS=N (default above)  TESSERA=path/to/tessera (default BUILD_DIR/cli/tessera)
 # Each method keeps the scene's depths (`--integrator` keeps maxDepth and rrDepth); its other
 # parameters are at their defaults (docs/plugins.md). Needs oiiotool (OpenImageIO's tools) and
@@ -45,7 +47,7 @@ spp_b=${5:-256}
 out=${6:-out/references}
 tessera=${TESSERA:-$build/cli/tessera}
 threads=${CR_THREADS:-2}
-method_a=sppm
+method_a=${CR_METHOD_A:-sppm}
 case "$scene" in glass-caustic) method_b=${CR_METHOD_B:-vcm} ;; *) method_b=${CR_METHOD_B:-bdpt} ;; esac
 max_blocks=${CR_MAX_BLOCKS:-}
 xml=scenes/$scene/scene.xml
@@ -53,11 +55,15 @@ xml=scenes/$scene/scene.xml
 [ -x "$tessera" ] || { echo "caustic_reference.sh: no tessera binary at $tessera" >&2; exit 1; }
 command -v oiiotool > /dev/null || { echo "caustic_reference.sh: needs oiiotool (apt install openimageio-tools)" >&2; exit 1; }
 command -v python3 > /dev/null || { echo "caustic_reference.sh: needs python3" >&2; exit 1; }
-case "$method_b" in
-  bdpt|vcm|path|volpath|ptracer) ;;
-  sppm) echo "caustic_reference.sh: CR_METHOD_B=sppm is method A itself: not an independent check" >&2; exit 1 ;;
-  *) echo "caustic_reference.sh: unknown CR_METHOD_B '$method_b' (bdpt, vcm, path, volpath, ptracer)" >&2; exit 1 ;;
-esac
+for m in "$method_a" "$method_b"; do
+  case "$m" in
+    sppm|bdpt|vcm|path|volpath|ptracer) ;;
+    *) echo "caustic_reference.sh: unknown method '$m' (sppm, bdpt, vcm, path, volpath, ptracer)" >&2; exit 1 ;;
+  esac
+done
+if [ "$method_a" = "$method_b" ]; then
+  echo "caustic_reference.sh: methods A and B are both $method_a: not an independent check" >&2; exit 1
+fi
 for n in "$renders" "$spp_a" "$spp_b" "$threads" ${max_blocks:+"$max_blocks"}; do
   [[ "$n" =~ ^[0-9]+$ ]] || { echo "caustic_reference.sh: '$n' is not a number" >&2; exit 1; }
 done

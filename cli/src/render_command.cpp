@@ -157,8 +157,8 @@ Command add_render_command(CLI::App& app) {
                 "Stop at a pass whose estimated relMSE is at most this (--spp is then the budget)")
       ->check(CLI::Range(0.0, 1.0));
   r->add_option("--guiding", o->guiding,
-                "Path guiding (path/volpath): the first half of the samples trains a guide, the rest use it "
-                "and make the image (default: on for a guided_path integrator, else off)")
+                "Path guiding (path/volpath): iterations of 1, 2, 4, ... samples per pixel each learn from the "
+                "ones before; the last four make the image (default: on for a guided_path integrator, else off)")
       ->check(CLI::IsMember({"on", "off"}));
   r->add_option("--adaptive", o->adaptive,
                 "Adaptive sampling: after the first quarter of the samples, each pass spends its samples "

@@ -123,7 +123,13 @@ TileResult render_lease(const Scene& scene, const Lease& lease, const SpatialTre
   std::optional<SpatialTree> recorder;
   if (lease.guide && lease.guide->train) recorder = make_recorder(*guide);
   std::optional<PathGuide> path_guide;
-  if (lease.guide) path_guide = PathGuide{guide, recorder ? &*recorder : nullptr, lease.guide->iteration > 0, lease.guide->train};
+  if (lease.guide) {
+    // (The job's guide settings are the scene's, as guide_plan() made them at submission.)
+    const std::optional<GuidePlan> plan = guide_plan(scene, true);
+    const bool guided_roulette = plan && plan->settings.roulette == GuideRoulette::Guided;
+    path_guide = PathGuide{guide, recorder ? &*recorder : nullptr, lease.guide->iteration > 0, lease.guide->train,
+                           guided_roulette};
+  }
   // A denoised job's units, or one's with AOV layers, also sum the AOVs.
   render_tile(scene, lease.rect, samples, lease.settings.seed, result.film, path_guide ? &*path_guide : nullptr,
               lease.settings.sums_aovs());
@@ -237,7 +243,9 @@ json guide_json(const JobPlan::Guide& g) {
           {"learn_bsdf_fraction", s.learn_bsdf_fraction},
           {"min_bsdf_fraction", s.min_bsdf_fraction},
           {"keep_energy", s.keep_energy},
-          {"discard_training", s.discard_training}};
+          {"combination", guide_combination_name(s.combination)},
+          {"combined_iterations", s.combined_iterations},
+          {"roulette", guide_roulette_name(s.roulette)}};
 }
 
 JobPlan::Guide guide_from_json(const json& j) {
@@ -254,7 +262,15 @@ JobPlan::Guide guide_from_json(const json& j) {
   s.learn_bsdf_fraction = j.at("learn_bsdf_fraction").get<bool>();
   s.min_bsdf_fraction = j.at("min_bsdf_fraction").get<float>();
   s.keep_energy = j.at("keep_energy").get<bool>();
-  s.discard_training = j.at("discard_training").get<bool>();
+  // (A plan stored before these three were settings rendered as they now name Discard and Throughput.)
+  const std::string combination = j.value("combination", guide_combination_name(GuideCombination::Discard));
+  const std::string roulette = j.value("roulette", guide_roulette_name(GuideRoulette::Throughput));
+  if (combination != "discard" && combination != "inversevar") throw std::invalid_argument("guide combination");
+  if (roulette != "throughput" && roulette != "guided") throw std::invalid_argument("guide roulette");
+  s.combination = combination == "discard" ? GuideCombination::Discard : GuideCombination::InverseVariance;
+  s.roulette = roulette == "throughput" ? GuideRoulette::Throughput : GuideRoulette::Guided;
+  s.combined_iterations = j.value("combined_iterations", 4);
+  if (s.combined_iterations < 1) throw std::invalid_argument("guide combined_iterations");
   return g;
 }
 

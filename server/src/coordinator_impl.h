@@ -260,6 +260,8 @@ std::string read_file(const std::string& path);
 
 /// A tile's checkpoint as stored: tile_result.h bytes (pass: its last pass; samples 0..sample_end).
 std::string encode_checkpoint(uint64_t job, const JobState::Checkpoint& cp);
+/// A stored checkpoint's sums: one tile result per film of the job (the first with its tile state).
+[[nodiscard]] bool decode_checkpoint(std::string_view bytes, std::vector<TileResult>& films, std::string& error);
 Status internal_error(const std::exception& e);
 inline Status unknown_job(uint64_t id) {
   return make_error(Code::NotFound, "unknown_job", "no job " + std::to_string(id));

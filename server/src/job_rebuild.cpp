@@ -58,14 +58,18 @@ std::unique_ptr<JobState> Coordinator::Impl::rebuild_job(const JobRow& row) {
   });
   // Each tile's checkpoint first, then the passes after it, in pass order: the film's sums as they were.
   store.for_each_checkpoint(row.id, [&](CheckpointRow&& c) {
-    TileResult sums;
+    std::vector<TileResult> films;
     std::string err;
-    if (!decode_tile_result(c.data, sums, err)) throw std::runtime_error(where + "stored checkpoint is corrupt: " + err);
-    if (c.tile >= job->num_tiles() || c.passes == 0 || c.passes > job->num_passes() ||
-        !(sums.film.rect() == job->sequencer().tiles()[c.tile]) || sums.film.has_aovs() != job->plan().settings.sums_aovs() ||
-        sums.sample_end != job->tile_sample_end(c.passes))
-      throw std::runtime_error(where + "stored checkpoint of tile " + std::to_string(c.tile) + " does not fit the job");
-    job->restore_checkpoint(c.tile, c.passes, std::move(sums.film), std::move(sums.tile_state));
+    if (!decode_checkpoint(c.data, films, err)) throw std::runtime_error(where + "stored checkpoint is corrupt: " + err);
+    bool fits = c.tile < job->num_tiles() && c.passes > 0 && c.passes <= job->num_passes() &&
+                films.size() == size_t(job->sequencer().program().films) &&
+                films[0].sample_end == job->tile_sample_end(c.passes);
+    for (const TileResult& f : films)
+      fits = fits && f.film.rect() == job->sequencer().tiles()[c.tile] && f.film.has_aovs() == job->plan().settings.sums_aovs();
+    if (!fits) throw std::runtime_error(where + "stored checkpoint of tile " + std::to_string(c.tile) + " does not fit the job");
+    std::vector<FilmTile> sums;
+    for (TileResult& f : films) sums.push_back(std::move(f.film));
+    job->restore_checkpoint(c.tile, c.passes, std::move(sums), std::move(films[0].tile_state));
   });
   store.for_each_result(row.id, [&](ResultRow&& r) {
     if (!job->has_unit(r.tile, r.pass)) return;
@@ -86,18 +90,62 @@ std::unique_ptr<JobState> Coordinator::Impl::rebuild_job(const JobRow& row) {
   return job;
 }
 
+namespace {
+
+// A checkpoint of a job with several films: the magic, the count, and each film's sums encoded as a
+// tile result, its length first (8 bytes each, little-endian). One film's is that tile result alone.
+constexpr std::string_view kFilmsMagic = "TSFILMS1";
+
+void put_u64(std::string& out, uint64_t v) {
+  for (int i = 0; i < 8; ++i) out.push_back(char((v >> (8 * i)) & 0xff));
+}
+
+uint64_t get_u64(std::string_view& in) {
+  uint64_t v = 0;
+  for (int i = 0; i < 8; ++i) v |= uint64_t(uint8_t(in[size_t(i)])) << (8 * i);
+  in.remove_prefix(8);
+  return v;
+}
+
+}  // namespace
+
 std::string encode_checkpoint(uint64_t job, const JobState::Checkpoint& cp) {
-  TileResult sums;
-  sums.job_id = job;
-  sums.tile = cp.tile;
-  sums.pass = cp.passes - 1;
-  sums.sample_end = cp.sample_end;
-  sums.film = cp.sums;
-  sums.tile_state = cp.tile_state;
-  // Uncompressed: a checkpoint is written for most results, by the group commit's one writer, and
-  // compressing (even zstd's fastest mode) took a third of that writer's time to save a fifth of
-  // the bytes (sums are noise in their low bits). One per tile is within the storage bound as is.
-  return encode_tile_result(sums, kUncompressed);
+  std::vector<std::string> parts;
+  for (size_t f = 0; f < cp.films.size(); ++f) {
+    TileResult sums;
+    sums.job_id = job;
+    sums.tile = cp.tile;
+    sums.pass = cp.passes - 1;
+    sums.sample_end = cp.sample_end;
+    sums.film = cp.films[f];
+    if (f == 0) sums.tile_state = cp.tile_state;
+    // Uncompressed: a checkpoint is written for most results, by the group commit's one writer, and
+    // compressing (even zstd's fastest mode) took a third of that writer's time to save a fifth of
+    // the bytes (sums are noise in their low bits). One per tile is within the storage bound as is.
+    parts.push_back(encode_tile_result(sums, kUncompressed));
+  }
+  if (parts.size() == 1) return std::move(parts[0]);
+  std::string out(kFilmsMagic);
+  put_u64(out, parts.size());
+  for (const std::string& p : parts) put_u64(out, p.size()), out += p;
+  return out;
+}
+
+bool decode_checkpoint(std::string_view bytes, std::vector<TileResult>& films, std::string& error) {
+  films.clear();
+  if (!bytes.starts_with(kFilmsMagic)) return decode_tile_result(bytes, films.emplace_back(), error);
+  bytes.remove_prefix(kFilmsMagic.size());
+  if (bytes.size() < 8) return error = "truncated", false;
+  const uint64_t count = get_u64(bytes);
+  for (uint64_t f = 0; f < count; ++f) {
+    if (bytes.size() < 8) return error = "truncated", false;
+    const uint64_t n = get_u64(bytes);
+    if (n > bytes.size() || !decode_tile_result(bytes.substr(0, n), films.emplace_back(), error))
+      return error = "film " + std::to_string(f) + ": " + (error.empty() ? "truncated" : error), false;
+    bytes.remove_prefix(n);
+  }
+  if (count == 0 || !bytes.empty()) return error = "film count or length", false;
+  return true;
 }
 
 }  // namespace tessera::server

@@ -23,7 +23,7 @@ bool parse_phase(const std::string& s, JobPhase& out) {
 }
 
 std::string farm_program_error(const PassProgram& program) {
-  if (program.films != 1) return "the farm combines one film per job";
+  if (program.films < 1) return "a job's passes enter no film";
   return {};
 }
 
@@ -161,7 +161,7 @@ JobState::Checkpoint JobState::film_checkpoint(uint32_t t) const {
   cp.tile = t;
   cp.from = folded_[t];
   cp.passes = passes_in_film(t);
-  cp.sums = seq_.films().tile_region(t);
+  cp.films = seq_.films().tile_regions(t);
   cp.tile_state = seq_.tile_state(t, cp.passes);
   return cp;
 }
@@ -185,18 +185,19 @@ std::optional<JobState::Checkpoint> JobState::checkpoint_with(size_t u, const Fi
   cp.passes = passes_in_film(t) + 1;
   cp.sample_end = sample_end(u);
   // The same additions Film::add_tile makes, in the same order: the film's region once it is in.
-  std::vector<PixelSums>& out = cp.sums.mutable_pixels();
-  const std::vector<PixelSums>& in = result.pixels();
-  const bool in_film = seq_.pass(pass_of(u)).film != kNoFilm;
-  for (size_t i = 0; i < out.size() && in_film; ++i) {
-    for (int c = 0; c < 3; ++c) {
-      out[i].sum[c] += in[i].sum[c];
-      out[i].sum_sq[c] += in[i].sum_sq[c];
+  if (const int f = seq_.pass(pass_of(u)).film; f != kNoFilm) {
+    std::vector<PixelSums>& out = cp.films[size_t(f)].mutable_pixels();
+    const std::vector<PixelSums>& in = result.pixels();
+    for (size_t i = 0; i < out.size(); ++i) {
+      for (int c = 0; c < 3; ++c) {
+        out[i].sum[c] += in[i].sum[c];
+        out[i].sum_sq[c] += in[i].sum_sq[c];
+      }
+      out[i].count += in[i].count;
+      if (cp.films[size_t(f)].has_aovs()) add_aov_sums(cp.films[size_t(f)].mutable_aovs()[i], result.aovs()[i]);
     }
-    out[i].count += in[i].count;
-    if (cp.sums.has_aovs()) add_aov_sums(cp.sums.mutable_aovs()[i], result.aovs()[i]);
   }
-  cp.sums.counters += result.counters;
+  cp.films[0].counters += result.counters;
   cp.tile_state = tile_state;
   return cp;
 }
@@ -214,8 +215,8 @@ std::vector<uint32_t> JobState::tile_passes(uint32_t from, uint32_t to) const {
   return out;
 }
 
-void JobState::restore_checkpoint(uint32_t t, uint32_t passes, FilmTile&& sums, std::string tile_state) {
-  seq_.films().restore_tile(t, passes, std::move(sums));
+void JobState::restore_checkpoint(uint32_t t, uint32_t passes, std::vector<FilmTile>&& films, std::string tile_state) {
+  seq_.films().restore_tile(t, passes, std::move(films));
   seq_.restore_tile_state(t, passes, std::move(tile_state));
   folded_[t] = passes;
 }

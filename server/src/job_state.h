@@ -31,8 +31,8 @@ const char* phase_name(JobPhase p);
 bool parse_phase(const std::string& s, JobPhase& out);
 inline bool is_terminal(JobPhase p) { return p == JobPhase::Done || p == JobPhase::Failed || p == JobPhase::Cancelled; }
 
-/// Whether the farm can run `program`: Tile and Paths passes into one film. (Per-iteration films
-/// have no checkpoint yet; the sequencer runs them locally.)
+/// Whether the farm can run `program` (Tile and Paths passes into one film or several): what it
+/// cannot, or empty.
 std::string farm_program_error(const PassProgram& program);
 
 class JobState {
@@ -187,7 +187,7 @@ class JobState {
   struct Checkpoint {
     uint32_t tile = 0, from = 0, passes = 0;  // results of passes from..passes-1 become redundant
     uint32_t sample_end = 0;                 // samples per pixel it holds
-    FilmTile sums;                           // (with the counters of those passes)
+    std::vector<FilmTile> films;             // the tile's sums in each film (the first with the passes' counters)
     std::string tile_state;                  // what the latest of those passes left (tile_state)
   };
   std::optional<Checkpoint> take_checkpoint(uint32_t tile, uint32_t min_new);
@@ -199,7 +199,7 @@ class JobState {
   /// Passes of the tile in the film (a stored result of an earlier pass is in a checkpoint).
   uint32_t passes_in_film(uint32_t tile) const { return seq_.films().next_pass(tile); }
   void checkpoint_failed(uint32_t tile, uint32_t from) { folded_[tile] = std::min(folded_[tile], from); }
-  void restore_checkpoint(uint32_t tile, uint32_t passes, FilmTile&& sums, std::string tile_state = {});
+  void restore_checkpoint(uint32_t tile, uint32_t passes, std::vector<FilmTile>&& films, std::string tile_state = {});
   /// Samples per pixel a tile's checkpoint of its passes before `next_pass` holds: the end of the
   /// latest Tile pass among them (Paths passes between them add none of a tile's own).
   uint32_t tile_sample_end(uint32_t next_pass) const;

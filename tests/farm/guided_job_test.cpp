@@ -21,7 +21,7 @@ using nlohmann::json;
 using server::Coordinator;
 using server::JobState;
 
-// 24 spp: passes 1, 2, 4, 8, 9; those ending within 12 samples (1, 3, 7) train, the rest sample.
+// 24 spp: iterations of 1, 2, 4 and 17 samples (passes 1, 2, 4, 17); the first three train.
 constexpr int kSpp = 24;
 
 // A room lit by a small sphere and the sky through its open side, guided by its integrator with a
@@ -44,11 +44,20 @@ constexpr const char* kGuidedXml = R"(<scene version="0.6.0">
   <emitter type="constant"><rgb name="radiance" value="0.2,0.25,0.3"/></emitter>
 </scene>)";
 
-LoadResult load_fixture_scene() { return load_scene(parse_scene_string(kGuidedXml, "scene.xml"), LoadOptions{}); }
+// The fixture with another sampleCombination ("inversevar": the last four iterations, a film each).
+std::string guided_xml(const std::string& combination) {
+  std::string xml = kGuidedXml;
+  const std::string discard = "value=\"discard\"";
+  return xml.replace(xml.find(discard), discard.size(), "value=\"" + combination + "\"");
+}
 
-std::string guided_bundle() {
+LoadResult load_fixture_scene(const std::string& combination = "discard") {
+  return load_scene(parse_scene_string(guided_xml(combination), "scene.xml"), LoadOptions{});
+}
+
+std::string guided_bundle(const std::string& combination = "discard") {
   TempDir src;
-  src.write("scene.xml", kGuidedXml);
+  src.write("scene.xml", guided_xml(combination));
   return pack_bundle(src.path.string(), {"scene.xml"});
 }
 
@@ -145,12 +154,12 @@ std::string render_guided_unit(Coordinator& c, const json& lease_json, const Sce
 // A coordinator stopped and started again every few results, in the middle of training (its
 // tree rebuilt from the stored guide and the training records of the pass in progress), with
 // adaptive sampling too.
-TEST(GuidedJob, RestartsDuringTrainingGiveTheLocalGuidedImage) {
+void expect_restarts_give_the_local_image(const std::string& combination) {
   TempDir dir;
-  LoadResult loaded = load_fixture_scene();
+  LoadResult loaded = load_fixture_scene(combination);
   const json settings = {{"tile_size", 8}, {"seed", 7}, {"spp", kSpp}, {"adaptive", true}};  // (guided: the scene says)
   int restarts = 0;
-  const uint64_t id = render_with_restarts(dir, settings, guided_bundle(), [&](Coordinator& c, const json& l) {
+  const uint64_t id = render_with_restarts(dir, settings, guided_bundle(combination), [&](Coordinator& c, const json& l) {
     return render_guided_unit(c, l, *loaded.scene, 7);
   }, restarts);
   EXPECT_GT(restarts, 5);
@@ -161,6 +170,12 @@ TEST(GuidedJob, RestartsDuringTrainingGiveTheLocalGuidedImage) {
   ASSERT_EQ(farm.values().size(), local.values().size());
   EXPECT_TRUE(std::memcmp(farm.values().data(), local.values().data(), local.values().size() * sizeof(float)) == 0);
 }
+
+TEST(GuidedJob, RestartsDuringTrainingGiveTheLocalGuidedImage) { expect_restarts_give_the_local_image("discard"); }
+
+// The same with the image made of the last iterations' films, combined by inverse variance: each
+// tile's checkpoint holds its sums in every film.
+TEST(GuidedJob, RestartsGiveTheLocalImageOfCombinedIterations) { expect_restarts_give_the_local_image("inversevar"); }
 
 }  // namespace
 }  // namespace tessera::test

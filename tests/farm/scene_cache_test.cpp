@@ -128,7 +128,7 @@ TEST(SceneCache, ArtifactsAreFetchedOnceCheckedAndCountedAgainstTheBudget) {
   GuidingSettings settings;
   settings.spatial_threshold = 1;
   for (int i = 0; i < 64; ++i) grown.record(grown.leaf_of(Vec3(0.1f, 0.2f, 0.3f)), Vec3(0, 0, 1), 1.f, 0.5f);
-  grown.end_iteration(0, settings);
+  grown.end_iteration(4, settings);
   const std::string bytes = encode_guide(grown), hash = sha256_hex(bytes);
   server.by_hash[hash] = bytes;
   const std::string wrong = std::string(64, 'a');

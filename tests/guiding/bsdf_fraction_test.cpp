@@ -101,10 +101,10 @@ TEST(BsdfFraction, EachLeafLearnsItsFractionAtTheEndOfAnIteration) {
     for (const Record& r : samples([](float x) { return guide_pdf(x); }, 5000, 5))
       tree.record_fraction(leaf, r.weight, r.bsdf, r.guide);
     EXPECT_EQ(tree.bsdf_fraction(leaf), 0.5f);  // (only at the barrier)
-    tree.end_iteration(0, s);
+    tree.end_iteration(4, s);
     EXPECT_FLOAT_EQ(tree.bsdf_fraction(leaf), learn ? 0.1f : 0.5f);
     // The next iteration starts from nothing: without records the fraction stays.
-    tree.end_iteration(1, s);
+    tree.end_iteration(8, s);
     EXPECT_FLOAT_EQ(tree.bsdf_fraction(leaf), learn ? 0.1f : 0.5f);
   }
 }

@@ -36,12 +36,12 @@ TEST(SpatialTree, ALeafIsSplitWhileItsHalvesStillHaveTooManySamples) {
   s.spatial_threshold = 400;
   SpatialTree first(unit_box());
   record_at(first, Vec3(0.1f), 1000, 1);
-  first.end_iteration(0, s);  // 1000 > 400, halves of 500 > 400, quarters of 250 are not
+  first.end_iteration(4, s);  // c·sqrt(4/4) = 400: 1000 > 400, halves of 500 > 400, quarters of 250 are not
   EXPECT_EQ(first.leaf_count(), 4u);
   EXPECT_EQ(first.node_count(), 7u);
   SpatialTree later(unit_box());
   record_at(later, Vec3(0.1f), 1000, 1);
-  later.end_iteration(2, s);  // the threshold grows with sqrt(2^iteration): 800
+  later.end_iteration(16, s);  // the threshold grows with sqrt(spp / 4): 800
   EXPECT_EQ(later.leaf_count(), 2u);
   // The one cut is along x at the middle.
   EXPECT_NE(later.leaf_of(Vec3(0.2f, 0.2f, 0.2f)), later.leaf_of(Vec3(0.7f, 0.2f, 0.2f)));
@@ -53,7 +53,7 @@ TEST(SpatialTree, PointsFindTheLeafOfTheirRegion) {
   s.spatial_threshold = 100;
   SpatialTree tree(unit_box());
   record_at(tree, Vec3(0.05f), 2000, 2);
-  tree.end_iteration(0, s);
+  tree.end_iteration(4, s);
   ASSERT_GT(tree.leaf_count(), 4u);
   // The first cut is x at 0.5, then y, then z; points on one side of every cut share a leaf.
   EXPECT_NE(tree.leaf_of(Vec3(0.2f, 0.2f, 0.2f)), tree.leaf_of(Vec3(0.7f, 0.2f, 0.2f)));
@@ -81,8 +81,8 @@ TEST(SpatialTree, TheSameRecordsInAnyOrderGiveTheSameTree) {
         for (size_t k = points.size() - 1 - t; k < points.size(); k -= 2) record_at(threaded, points[k], 100, 10 * it + k);
       });
     for (std::thread& t : threads) t.join();
-    serial.end_iteration(it, s);
-    threaded.end_iteration(it, s);
+    serial.end_iteration(4u << it, s);
+    threaded.end_iteration(4u << it, s);
     ASSERT_TRUE(serial == threaded) << "iteration " << it;
   }
   EXPECT_GT(serial.leaf_count(), 8u);
@@ -95,7 +95,7 @@ TEST(SpatialTree, NothingIsSplitBeyondTheMemoryCap) {
   SpatialTree tree(unit_box());
   for (int it = 0; it < 3; ++it) {
     record_at(tree, Vec3(0.3f), 5000, 5 + it);
-    tree.end_iteration(it, s);
+    tree.end_iteration(4u << it, s);
   }
   EXPECT_EQ(tree.leaf_count(), 1u);
   EXPECT_LE(tree.bytes(), s.max_bytes);
@@ -107,7 +107,7 @@ TEST(SpatialTree, NothingIsSplitBeyondTheMemoryCap) {
   // A larger cap lets it split.
   s.max_bytes = size_t(256) << 20;
   record_at(tree, Vec3(0.3f), 5000, 9);
-  tree.end_iteration(3, s);
+  tree.end_iteration(32, s);
   EXPECT_GT(tree.leaf_count(), 1u);
 }
 

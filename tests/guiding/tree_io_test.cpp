@@ -32,7 +32,7 @@ SpatialTree trained_tree() {
   s.spatial_threshold = 300;
   for (int it = 0; it < 3; ++it) {
     record_some(tree, 4000, uint64_t(it));
-    tree.end_iteration(it, s);
+    tree.end_iteration(4u << it, s);
   }
   return tree;
 }
@@ -60,8 +60,8 @@ TEST(TreeIo, RecordsSplitAmongRecordersAddUpToRecordingEverything) {
   ASSERT_TRUE(add_records(merged, write_records(a), error)) << error;
   EXPECT_TRUE(merged == direct);
   GuidingSettings s;
-  direct.end_iteration(3, s);
-  merged.end_iteration(3, s);
+  direct.end_iteration(32, s);
+  merged.end_iteration(32, s);
   EXPECT_TRUE(merged == direct) << "the next tree is the same";
   EXPECT_LT(write_records(a).size(), write_tree(base).size()) << "records are sparse";
 }

@@ -50,7 +50,7 @@ TEST(GuidedPathLoader, MapsThePluginsParameters) {
   EXPECT_EQ(s.max_depth, 5);
   ASSERT_TRUE(s.guiding.has_value());
   EXPECT_TRUE(s.guiding->learn_bsdf_fraction);
-  EXPECT_TRUE(s.guiding->discard_training);
+  EXPECT_EQ(s.guiding->combination, GuideCombination::Discard);
   EXPECT_FLOAT_EQ(s.guiding->bsdf_fraction, 0.4f);
   EXPECT_DOUBLE_EQ(s.guiding->spatial_threshold, 4000);
   EXPECT_NEAR(s.guiding->directional_threshold, 0.02, 1e-7);
@@ -69,7 +69,7 @@ TEST(GuidedPathLoader, ThePluginsDefaultsAndItsNotes) {
   for (const auto& m : r.messages) notes += m.text + "\n";
   EXPECT_NE(notes.find("sampleCombination"), std::string::npos) << notes;
   EXPECT_NE(notes.find("next-event estimation"), std::string::npos) << notes;  // nee "never"
-  EXPECT_TRUE(r.scene->integrator.guiding->discard_training);
+  EXPECT_EQ(r.scene->integrator.guiding->combination, GuidingSettings{}.combination);
   EXPECT_EQ(r.scene->sampler.sample_count, 64);
 }
 
@@ -101,7 +101,7 @@ TEST(GuidedPathLoader, OutOfRangeValuesNameTheLineAndParameter) {
 TEST(GuidedPathLoader, UnimplementedOptionsAreUnsupported) {
   for (const std::string& param : {std::string("<string name=\"spatialFilter\" value=\"box\"/>\n"),
                                    std::string("<string name=\"directionalFilter\" value=\"box\"/>\n"),
-                                   std::string("<string name=\"sampleCombination\" value=\"inversevar\"/>\n"),
+                                   std::string("<string name=\"sampleCombination\" value=\"automatic\"/>\n"),
                                    std::string("<string name=\"bsdfSamplingFractionLoss\" value=\"var\"/>\n")}) {
     EXPECT_THROW((void)load(kSpp + param), UnsupportedError) << param;
     LoadResult r = load(kSpp + param, /*allow_unsupported=*/true);
@@ -109,6 +109,12 @@ TEST(GuidedPathLoader, UnimplementedOptionsAreUnsupported) {
     EXPECT_EQ(r.unsupported[0].loc.line, 5) << param;
     EXPECT_TRUE(r.scene->integrator.guiding.has_value());
   }
+}
+
+TEST(GuidedPathLoader, InverseVarianceCombinesTheLastIterations) {
+  LoadResult r = load(kSpp + "<string name=\"sampleCombination\" value=\"inversevar\"/>\n");
+  EXPECT_EQ(r.scene->integrator.guiding->combination, GuideCombination::InverseVariance);
+  EXPECT_TRUE(r.unsupported.empty());
 }
 
 TEST(GuidedPathLoader, OtherIntegratorsAskForNoGuiding) {

@@ -65,8 +65,18 @@ void SpatialTree::split(uint32_t node) {
   nodes_[node].child[1] = lo + 1;
 }
 
-void SpatialTree::end_iteration(int iteration, const GuidingSettings& settings) {
-  const double threshold = settings.spatial_threshold * std::sqrt(std::ldexp(1.0, std::min(iteration, 60)));
+const char* guide_combination_name(GuideCombination c) {
+  return c == GuideCombination::Discard ? "discard" : "inversevar";
+}
+
+const char* guide_roulette_name(GuideRoulette r) { return r == GuideRoulette::Throughput ? "throughput" : "guided"; }
+
+double spatial_split_threshold(const GuidingSettings& settings, uint32_t iteration_spp) {
+  return settings.spatial_threshold * std::sqrt(double(iteration_spp) / 4.0);
+}
+
+void SpatialTree::end_iteration(uint32_t iteration_spp, const GuidingSettings& settings) {
+  const double threshold = spatial_split_threshold(settings, iteration_spp);
   size_t total = bytes();
   // In index order, children right after they are made: a half that still has too many samples
   // is split again. The order, and so the result, depends only on the counts.

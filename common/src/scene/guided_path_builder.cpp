@@ -50,14 +50,17 @@ void read_budget(BuildState& st, const SceneNode& node) {
 
 void read_combination(BuildState& st, const SceneNode& node, GuidingSettings& g) {
   const std::string name = name_in(node, "sample_combination", "sampleCombination");
+  const std::string tessera_default = guide_combination_name(g.combination);
   if (!node.peek(name)) {
-    st.ctx.note(node.loc, node.describe() + ": no sampleCombination (the plugin's default is \"automatic\"); "
-                                            "rendered as \"discard\": the image is the passes after the first half of the budget");
-  } else if (const std::string v = choice(node, name, "automatic", {"discard", "automatic", "inversevar"}); v != "discard") {
-    st.ctx.unsupported(node.loc_of(name), "sampleCombination \"" + v + "\" of " + node.describe(),
-                       "discard (the passes after the first half of the budget)");
+    st.ctx.note(node.loc, node.describe() + ": no sampleCombination (the plugin's default is \"automatic\"); rendered as \"" +
+                              tessera_default + "\"");
+    return;
   }
-  g.discard_training = true;
+  const std::string v = choice(node, name, "automatic", {"discard", "automatic", "inversevar"});
+  if (v == "automatic")
+    st.ctx.unsupported(node.loc_of(name), "sampleCombination \"automatic\" of " + node.describe(), tessera_default);
+  else
+    g.combination = v == "discard" ? GuideCombination::Discard : GuideCombination::InverseVariance;
 }
 
 void read_filters_and_loss(BuildState& st, const SceneNode& node, GuidingSettings& g) {

@@ -6,6 +6,14 @@
 #include <limits>
 
 namespace tessera {
+namespace {
+
+// A pixel's term in an iteration's noise estimate counts at most this (its standard error at its
+// own value): Müller clamps each pixel's variance likewise, so that a firefly does not decide an
+// iteration's weight alone.
+constexpr double kCombineClamp = 1.0;
+
+}  // namespace
 
 FilmAssembler::FilmAssembler(const PassProgram& program, std::vector<TileRect> tiles, const TileRect& window,
                              int full_width, int full_height, bool aovs)
@@ -138,7 +146,7 @@ std::vector<double> FilmAssembler::weights() const {
   }
   double total = 0;
   for (size_t f = 0; f < films_.size(); ++f) {
-    const double e = estimate_noise(*films_[f]).rel_mse;
+    const double e = estimate_noise(*films_[f], kCombineClamp).rel_mse;
     w[f] = std::isfinite(e) ? 1.0 / (e + 1e-12) : 0.0;
     total += w[f];
   }
@@ -186,22 +194,64 @@ Image FilmAssembler::film_image(int f) const {
   return img;
 }
 
+// Row y of the image by weights `w`: each film's pixel_row, summed in double and rounded once.
+void FilmAssembler::combined_row(int y, const std::vector<double>& w, std::vector<float>& out) const {
+  if (w.size() == 1) return pixel_row(0, y, out);
+  std::vector<float> row(out.size());
+  std::vector<double> sum(out.size(), 0.0);
+  for (size_t f = 0; f < films_.size(); ++f) {
+    if (w[f] == 0) continue;
+    pixel_row(int(f), y, row);
+    for (size_t i = 0; i < row.size(); ++i) sum[i] += w[f] * double(row[i]);
+  }
+  for (size_t i = 0; i < out.size(); ++i) out[i] = float(sum[i]);
+}
+
 void FilmAssembler::image_rows(Image& img, int row_begin, int row_end) const {
   TESSERA_CHECK(img.width() == window_.width() && img.height() == window_.height() && row_begin >= 0 &&
                 row_end <= window_.height());
   if (films_.empty()) return;  // (black, as allocated)
   const std::vector<double> w = weights();
-  std::vector<float> row(size_t(window_.width()) * 3), sum(row.size());
+  std::vector<float> row(size_t(window_.width()) * 3);
   for (int y = window_.y0 + row_begin; y < window_.y0 + row_end; ++y) {
-    std::fill(sum.begin(), sum.end(), 0.f);
-    for (size_t f = 0; f < films_.size(); ++f) {
-      if (w[f] == 0) continue;
-      pixel_row(int(f), y, row);
-      for (size_t i = 0; i < row.size(); ++i) sum[i] = w.size() == 1 ? row[i] : float(double(sum[i]) + w[f] * row[i]);
-    }
+    combined_row(y, w, row);
     for (int x = 0; x < window_.width(); ++x)
-      img.set_rgb(x, y - window_.y0, Rgb(sum[size_t(x) * 3], sum[size_t(x) * 3 + 1], sum[size_t(x) * 3 + 2]));
+      img.set_rgb(x, y - window_.y0, Rgb(row[size_t(x) * 3], row[size_t(x) * 3 + 1], row[size_t(x) * 3 + 2]));
   }
+}
+
+Film FilmAssembler::combined_film() const {
+  Film out(window_, full_width_, full_height_, aovs_);
+  if (films_.empty()) return out;
+  const std::vector<double> w = weights();
+  FilmTile all(window_, aovs_);
+  std::vector<float> row(size_t(window_.width()) * 3);
+  for (int y = window_.y0; y < window_.y1; ++y) {
+    combined_row(y, w, row);
+    for (int x = window_.x0; x < window_.x1; ++x) {
+      const size_t i = size_t(y - window_.y0) * size_t(window_.width()) + size_t(x - window_.x0);
+      uint64_t count = 0;
+      Rgb variance;  // of the combined mean: the sum of w_f^2 times each film's
+      for (size_t f = 0; f < films_.size(); ++f) {
+        const uint64_t n = films_[f]->pixel({x, y}).count;
+        count += n;
+        if (w[f] > 0 && n > 0) variance += films_[f]->sample_variance({x, y}) * float(w[f] * w[f] / double(n));
+      }
+      // Over a power-of-two count the sum divides back to the image's float exactly; the sum of
+      // squares gives the sample variance whose variance of the mean is the combination's.
+      const double n = count ? std::ldexp(1.0, int(std::floor(std::log2(double(count))))) : 0.0;
+      PixelSums& px = all.mutable_pixels()[i];
+      px.count = uint64_t(n);
+      for (int c = 0; c < 3 && n > 0; ++c) {
+        const double m = double(row[size_t(x - window_.x0) * 3 + size_t(c)]);
+        px.sum[c] = m * n;
+        px.sum_sq[c] = double(variance[c]) * n * (n - 1) + n * m * m;
+      }
+      if (all.has_aovs()) all.mutable_aovs()[i] = films_[size_t(primary_)]->aov({x, y});
+    }
+  }
+  out.add_tile(all);
+  return out;
 }
 
 void FilmAssembler::aov_rows(AovLayer layer, Image& img, int row_begin, int row_end) const {
@@ -210,28 +260,31 @@ void FilmAssembler::aov_rows(AovLayer layer, Image& img, int row_begin, int row_
   if (film.has_aovs() || layer == AovLayer::Variance) film.aov_rows(layer, img, row_begin, row_end);
 }
 
-FilmTile FilmAssembler::tile_region(uint32_t tile) const {
+std::vector<FilmTile> FilmAssembler::tile_regions(uint32_t tile) const {
   const TileRect& r = tiles_[tile];
-  FilmTile out(r, aovs_);
-  if (!films_.empty()) {
-    const Film& film = *films_[size_t(primary_)];
-    std::vector<PixelSums>& px = out.mutable_pixels();
+  std::vector<FilmTile> out;
+  for (int f = 0; f < program_.films; ++f) {
+    FilmTile& region = out.emplace_back(r, aovs_);
+    if (films_.empty()) continue;
+    const Film& film = *films_[size_t(f)];
+    std::vector<PixelSums>& px = region.mutable_pixels();
     for (int y = r.y0; y < r.y1; ++y)
       for (int x = r.x0; x < r.x1; ++x) {
         const size_t i = size_t(y - r.y0) * size_t(r.width()) + size_t(x - r.x0);
         px[i] = film.pixel({x, y});
-        if (out.has_aovs()) out.mutable_aovs()[i] = film.aov({x, y});
+        if (region.has_aovs()) region.mutable_aovs()[i] = film.aov({x, y});
       }
   }
-  out.counters = tile_counters_[tile];
+  out[0].counters = tile_counters_[tile];
   return out;
 }
 
-void FilmAssembler::restore_tile(uint32_t tile, uint32_t next_pass, FilmTile&& sums) {
+void FilmAssembler::restore_tile(uint32_t tile, uint32_t next_pass, std::vector<FilmTile>&& sums) {
+  TESSERA_CHECK(sums.size() == size_t(program_.films));
   allocate();
-  if (!films_.empty()) films_[size_t(primary_)]->add_tile(sums);
-  counters_ += sums.counters;
-  tile_counters_[tile] = sums.counters;
+  for (size_t f = 0; f < sums.size() && !films_.empty(); ++f) films_[f]->add_tile(sums[f]);
+  counters_ += sums[0].counters;
+  tile_counters_[tile] = sums[0].counters;
   next_[tile] = next_tile_pass(next_pass);
   ++changes_;
 }

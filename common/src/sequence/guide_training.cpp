@@ -7,8 +7,8 @@
 
 namespace tessera {
 
-GuideTraining::GuideTraining(const Bounds3& bounds, const GuidingSettings& settings)
-    : bounds_(bounds), settings_(settings) {}
+GuideTraining::GuideTraining(const Bounds3& bounds, const GuidingSettings& settings, std::vector<uint32_t> iteration_spp)
+    : bounds_(bounds), settings_(settings), iteration_spp_(std::move(iteration_spp)) {}
 
 std::shared_ptr<const Artifact> GuideTraining::build(uint32_t iteration) {
   TESSERA_CHECK(int64_t(iteration) == made_ + 1);
@@ -17,7 +17,8 @@ std::shared_ptr<const Artifact> GuideTraining::build(uint32_t iteration) {
     tree_ = std::make_shared<const SpatialTree>(bounds_, settings_.bsdf_fraction);
   } else {
     std::unique_ptr<SpatialTree> next = training_ ? std::move(training_) : std::make_unique<SpatialTree>(*tree_);
-    next->end_iteration(int(iteration) - 1, settings_);
+    TESSERA_CHECK(iteration <= iteration_spp_.size());
+    next->end_iteration(iteration_spp_[iteration - 1], settings_);
     tree_ = std::move(next);
   }
   build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -13,15 +13,28 @@ std::vector<uint32_t> pass_schedule(uint32_t spp) {
     uint32_t n = std::min(next, spp - done);
     passes.push_back(n);
     done += n;
-    next = std::min(next * 2, 64u);
+    next = std::min(next * 2, kMaxPassSamples);
   }
   return passes;
 }
 
-bool guiding_trains_pass(const std::vector<uint32_t>& passes, size_t pass, uint32_t spp) {
-  uint32_t end = 0;
-  for (size_t p = 0; p <= pass && p < passes.size(); ++p) end += passes[p];
-  return pass < passes.size() && end <= spp / 2;
+std::vector<uint32_t> guide_iterations(uint32_t spp) {
+  std::vector<uint32_t> iterations;
+  uint64_t next = 1;
+  for (uint32_t remaining = spp; remaining > 0; next *= 2) {
+    uint32_t n = uint32_t(std::min<uint64_t>(next, remaining));
+    // (As Müller's: an iteration that could not be followed by one twice its size takes the rest.)
+    if (uint64_t(remaining - n) < 2 * uint64_t(n)) n = remaining;
+    iterations.push_back(n);
+    remaining -= n;
+  }
+  return iterations;
+}
+
+std::vector<uint32_t> iteration_passes(uint32_t samples) {
+  std::vector<uint32_t> passes(samples / kMaxPassSamples, kMaxPassSamples);
+  if (samples % kMaxPassSamples) passes.push_back(samples % kMaxPassSamples);
+  return passes;
 }
 
 std::vector<TileRect> make_tiles(const TileRect& window, int tile_size) {

@@ -35,7 +35,8 @@ class PathUnits final : public UnitRenderer {
     std::optional<PathGuide> guide;
     if (work.uses) {
       const auto& tree = static_cast<const GuideArtifact*>(sequencer.artifact(*work.uses))->tree();
-      guide = PathGuide{&tree, work.feeds ? &guide_->recorder() : nullptr, *work.uses > 0, work.feeds.has_value()};
+      guide = PathGuide{&tree, work.feeds ? &guide_->recorder() : nullptr, *work.uses > 0, work.feeds.has_value(),
+                        guide_->settings().roulette == GuideRoulette::Guided};
     }
     const PassSamples samples = work.samples ? *work.samples : PassSamples::uniform(work.rect, work.sample_begin, work.sample_end);
     render_tile(scene_, *integrator_, work.rect, samples, seed_, result.tile, guide ? &*guide : nullptr, aovs_);
@@ -107,7 +108,9 @@ Film render(const Scene& scene, const RenderSettings& settings, const ProgressCa
     if (progress) progress(prog);
   });
   FilmAssembler& films = sequencer.films();
-  Film film = films.allocated() ? films.take_film(films.primary_film()) : Film(scene.film, settings.aovs);
+  Film film = !films.allocated()                                      ? Film(scene.film, settings.aovs)
+              : sequencer.program().combine == FilmCombine::InverseVariance ? films.combined_film()
+                                                                          : films.take_film(films.primary_film());
   film.add_counters(films.counters());
   if (stats) {
     stats->counters = films.counters();

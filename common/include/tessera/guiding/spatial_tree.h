@@ -19,9 +19,34 @@
 
 namespace tessera {
 
+/// How a guided render's iterations make its image (Müller's sampleCombination).
+enum class GuideCombination : uint8_t {
+  /// The last iteration alone (Müller 2017's "discard"): it has at least half the samples.
+  Discard,
+  /// The last `combined_iterations` iterations, each image weighted by the inverse of its
+  /// estimated (clamped) relMSE (Müller 2019's "inversevar"). Consistent, not unbiased: the
+  /// weights come from the images they weigh.
+  InverseVariance,
+};
+const char* guide_combination_name(GuideCombination c);
+
+/// Russian roulette on a guided render's paths.
+enum class GuideRoulette : uint8_t {
+  /// From the throughput, as unguided paths (path_integrator: Mitsuba 3's rule).
+  Throughput,
+  /// From the throughput times how much more light than its region's average the guide expects
+  /// from the sampled direction (at least 1), in the spirit of Vorba and Křivánek's adjoint-driven
+  /// roulette: a guided direction toward bright light has a small f·cos/p, which a throughput rule
+  /// would end. (Müller's code lets guided paths survive with 0.99 whatever they carry, which in
+  /// closed interiors with next-event estimation makes every path run to its maximum depth.)
+  Guided,
+};
+const char* guide_roulette_name(GuideRoulette r);
+
 struct GuidingSettings {
-  /// A leaf is split once its samples in an iteration exceed this times sqrt(2^iteration)
-  /// (Müller's sTreeThreshold).
+  /// c of the spatial split rule: a leaf is split at the end of an iteration of spp_k samples per
+  /// pixel once its samples in it exceed c·sqrt(spp_k / 4) (Müller's sTreeThreshold, which his
+  /// plugin applies as c·sqrt(2^k·sppPerPass / 4)).
   double spatial_threshold = 12000.0;
   /// A direction quadrant is split when its share of its leaf's energy exceeds this (dTreeThreshold).
   double directional_threshold = 0.01;
@@ -31,18 +56,20 @@ struct GuidingSettings {
   float bsdf_fraction = 0.5f;
   /// Learn that probability per leaf (bsdf_fraction.h); otherwise it stays `bsdf_fraction`.
   bool learn_bsdf_fraction = true;
-  /// The least fraction learning may choose: a BSDF-sampled direction's weight is then at most
-  /// 1 / this times the BSDF's own, so that long paths through over-guided regions cannot
-  /// multiply their throughput at every bounce.
-  float min_bsdf_fraction = 0.3f;
+  /// The least fraction learning may choose (0: any candidate, as Müller's optimiser may).
+  float min_bsdf_fraction = 0.f;
   /// Each iteration's directional trees start from the energy learned so far, rather than from
   /// zero (Müller resets them): light found once, such as the sun through a window, stays found.
   bool keep_energy = true;
-  /// The image is made of the passes after training only (Müller 2017): the training passes,
-  /// sampled with little or nothing learned, carry the fireflies guiding is there to avoid.
-  /// Otherwise every sample counts with weight 1.
-  bool discard_training = true;
+  GuideCombination combination = GuideCombination::InverseVariance;
+  /// (InverseVariance) How many of the last iterations the image combines (Müller: 4).
+  int combined_iterations = 4;
+  GuideRoulette roulette = GuideRoulette::Guided;
 };
+
+/// The samples a leaf must exceed in an iteration of `iteration_spp` samples per pixel to be split:
+/// c·sqrt(iteration_spp / 4).
+double spatial_split_threshold(const GuidingSettings& settings, uint32_t iteration_spp);
 
 class SpatialTree {
  public:
@@ -64,11 +91,11 @@ class SpatialTree {
     leaves_[leaf].fraction_loss.record(weight, bsdf_pdf, guide_pdf);
   }
 
-  /// Ends training iteration `iteration` (0, 1, ...): splits the leaves that saw enough samples
-  /// (within the memory cap), then makes each leaf's recorded tree its sampling tree and starts a
+  /// Ends a training iteration of `iteration_spp` samples per pixel: splits the leaves that saw
+  /// more than spatial_split_threshold() samples in it (within the memory cap), then makes each leaf's recorded tree its sampling tree and starts a
   /// refined one for the next iteration, and (if learned) picks each leaf's BSDF fraction from the
   /// iteration's loss. Not thread-safe: at a pass barrier.
-  void end_iteration(int iteration, const GuidingSettings& settings);
+  void end_iteration(uint32_t iteration_spp, const GuidingSettings& settings);
 
   size_t leaf_count() const { return leaves_.size(); }
   size_t node_count() const { return nodes_.size(); }

@@ -12,6 +12,8 @@
 
 #include "tessera/render/film.h"
 
+#include <limits>
+
 namespace tessera {
 
 struct NoiseEstimate {
@@ -19,6 +21,8 @@ struct NoiseEstimate {
   uint64_t pixels = 0;    // pixels it averages
 };
 
-NoiseEstimate estimate_noise(const Film& film);
+/// With `clamp`, each pixel's and channel's term counts at most `clamp` (a single firefly then
+/// weighs no more than any other noisy pixel).
+NoiseEstimate estimate_noise(const Film& film, double clamp = std::numeric_limits<double>::infinity());
 
 }  // namespace tessera

@@ -30,6 +30,9 @@ struct PathGuide {
   SpatialTree* records = nullptr;     // where training records go: `tree`, or a recorder of it (tree_io.h)
   bool sample = false;                // guide directions with the tree's learned distributions
   bool train = false;                 // record the pass's radiance into `records`
+  /// Where the guide samples, paths survive Russian roulette with probability 0.99
+  /// (GuideRoulette::Guided) rather than by their throughput.
+  bool guided_roulette = false;
 };
 
 /// The vertices of one path that sampled a direction to record, and at the path's end the

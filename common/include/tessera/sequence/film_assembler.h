@@ -9,8 +9,9 @@
 // - The image (FilmCombine, pass_program.h): each film's pixel is its mean plus its splat sum over
 //   the light paths per pixel folded into it (a light tracer's splat scale); with Sum that is the
 //   image, with InverseVariance the films' images are averaged with weights 1 / (relMSE + 1e-12),
-//   relMSE the film's estimate (noise_estimate.h), 0 for a film without one (all equal when no
-//   film has one). The AOV layers are the last film's (the one the last pass enters).
+//   relMSE the film's estimate (noise_estimate.h, each pixel's term clamped at 1), 0 for a film
+//   without one (all equal when no film has one), summed in double and rounded once. The AOV
+//   layers are the last film's (the one the last pass enters).
 //
 // Films are allocated on the first result (a queued farm job holds none) and can be released once
 // the image is written. Not thread-safe: the caller serialises.
@@ -66,6 +67,10 @@ class FilmAssembler {
   const Film& film(int f) const { return *films_[size_t(f)]; }
   /// Moves film `f` out with its splats (a finished local render; the assembler is spent).
   Film take_film(int f);
+  /// (InverseVariance) A film holding the image: each pixel's mean is image()'s bits, its
+  /// variance of the mean the combination's (the weighted films' variances), over a count that
+  /// is the largest power of two within its samples; the AOVs are the primary film's.
+  Film combined_film() const;
   int primary_film() const { return primary_; }
 
   /// The estimate of the image's relMSE (Sum: film 0's; InverseVariance: 1 / the sum of the films'
@@ -84,11 +89,11 @@ class FilmAssembler {
   void aov_rows(AovLayer layer, Image& img, int row_begin, int row_end) const;
 
   // Checkpoints (a coordinator stores a tile's sums in place of its results): the tile's region of
-  // the primary film with the counters of the passes in it, and back.
-  FilmTile tile_region(uint32_t tile) const;
-  /// Rebuilding: the tile's sums over every pass before `next_pass` (their results are then never
-  /// added); adding them to a zero film reproduces the sums bit for bit.
-  void restore_tile(uint32_t tile, uint32_t next_pass, FilmTile&& sums);
+  // each film, the first with the counters of the passes in them, and back.
+  std::vector<FilmTile> tile_regions(uint32_t tile) const;
+  /// Rebuilding: the tile's sums in each film over every pass before `next_pass` (their results
+  /// are then never added); adding them to zero films reproduces the sums bit for bit.
+  void restore_tile(uint32_t tile, uint32_t next_pass, std::vector<FilmTile>&& sums);
 
  private:
   void allocate();
@@ -97,6 +102,7 @@ class FilmAssembler {
   uint64_t unit_paths(uint32_t pass, uint32_t index) const;
   std::vector<double> weights() const;
   void pixel_row(int f, int y, std::vector<float>& row) const;
+  void combined_row(int y, const std::vector<double>& w, std::vector<float>& out) const;
 
   PassProgram program_;
   std::vector<TileRect> tiles_;

@@ -16,12 +16,15 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace tessera {
 
 class GuideTraining final : public ArtifactBuilder {
  public:
-  GuideTraining(const Bounds3& bounds, const GuidingSettings& settings);
+  /// `iteration_spp[i]`: the samples per pixel of training iteration i, whose records make
+  /// artifact i + 1 (they set its spatial split threshold).
+  GuideTraining(const Bounds3& bounds, const GuidingSettings& settings, std::vector<uint32_t> iteration_spp);
 
   std::shared_ptr<const Artifact> build(uint32_t iteration) override;
   [[nodiscard]] bool check_records(uint32_t iteration, std::string_view records, std::string& error) const override;
@@ -32,6 +35,7 @@ class GuideTraining final : public ArtifactBuilder {
 
   /// Where a local render's training units record (a copy of the latest tree, made on first use).
   SpatialTree& recorder();
+  const GuidingSettings& settings() const { return settings_; }
   /// The latest tree (null before the first is built, and once released).
   const SpatialTree* latest() const { return tree_.get(); }
   /// How long the latest build took (at a barrier).
@@ -43,6 +47,7 @@ class GuideTraining final : public ArtifactBuilder {
  private:
   Bounds3 bounds_;
   GuidingSettings settings_;
+  std::vector<uint32_t> iteration_spp_;
   int64_t made_ = -1;                          // the latest built iteration
   std::shared_ptr<const SpatialTree> tree_;    // its tree
   std::unique_ptr<SpatialTree> training_;      // that tree plus the records added so far

@@ -14,9 +14,16 @@ namespace tessera {
 /// so a preview (and the farm's first results) arrive quickly; capped so passes stay balanced.
 std::vector<uint32_t> pass_schedule(uint32_t spp);
 
-/// Whether pass `pass` of `passes` (for `spp` samples) trains the guide of a guided render: those
-/// that end within the first half of the samples (none with fewer than 2 samples per pixel).
-bool guiding_trains_pass(const std::vector<uint32_t>& passes, size_t pass, uint32_t spp);
+/// Samples per pixel of a guided render's iterations (Müller et al. 2017, a budget in samples):
+/// 1, 2, 4, ... doubling without a cap, until what would remain after the next is less than twice
+/// it; that one takes the rest, so the last iteration has at least half the samples or so.
+/// Every iteration but the last trains the guide the next one samples with.
+std::vector<uint32_t> guide_iterations(uint32_t spp);
+
+/// The passes of one iteration of `samples` per pixel: at most 64 each (kMaxPassSamples), the
+/// last taking the remainder, so that the farm's units stay small however long an iteration is.
+std::vector<uint32_t> iteration_passes(uint32_t samples);
+inline constexpr uint32_t kMaxPassSamples = 64;
 
 /// Tiles of `window`, row-major, `tile_size` square (smaller at the right and bottom edges).
 std::vector<TileRect> make_tiles(const TileRect& window, int tile_size);

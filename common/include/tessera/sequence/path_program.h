@@ -46,11 +46,13 @@ std::string path_program_error(const PathProgramOptions& options);
 
 /// The program: with a target error every pass after the first may stop the render. Adaptive: the
 /// passes that adaptive_pass() allows, and all after them, are barriers with adaptive counts.
-/// Guided: the training passes (guiding_trains_pass) render with the guide learned so far (pass p
-/// with iteration p) and feed the next, pass p > 0 waits for the guide it renders with, and every
-/// later pass renders with the last; with discard_training the training passes enter no film.
-/// Without a training pass (fewer than 2 samples a pixel) nothing is guided. Throws
-/// std::invalid_argument with path_program_error()'s reason.
+/// Guided: the passes are guide_iterations()' iterations, each cut by iteration_passes(); iteration
+/// k renders with the guide learned over iterations 0 .. k-1 (artifact k; the first pass of
+/// iteration k > 0 is a barrier) and, but for the last, feeds artifact k + 1. The last iteration
+/// enters film 0 (GuideCombination::Discard), or the last `combined_iterations` enter a film each,
+/// combined by inverse variance; the others enter none. With a single iteration (fewer than 3
+/// samples a pixel) nothing is guided. Throws std::invalid_argument with path_program_error()'s
+/// reason.
 PassProgram path_program(const PathProgramOptions& options);
 
 /// The sequencer of that program over `frame`, with the guide's training (guide_training.h) as its

@@ -31,12 +31,11 @@ struct RenderSettings {
   /// is at most this; spp is then the budget. Decided on whole passes only, so the image equals
   /// a render with the spp reached (and a farm job with the same target).
   double target_error = 0;
-  /// Path guiding (path/volpath only; guided() in pass_program.h decides, unset: as the scene's
-  /// integrator says): the passes that end within the first half of the samples train an SD-tree
-  /// (guiding_trains_pass), each later pass samples with what the training passes learned. The
-  /// image is the passes after training (or every pass, see GuidingSettings::discard_training),
-  /// each sample with weight 1, so it converges to the unguided image; the learned trees are the
-  /// same bits for any thread count or tile size.
+  /// Path guiding (path/volpath only; guide_plan() in path_program.h decides, unset: as the
+  /// scene's integrator says): iterations of 1, 2, 4, ... samples per pixel (guide_iterations),
+  /// each sampling with what the ones before learned; the image is the last iteration, or the
+  /// last few combined by inverse variance (GuidingSettings::combination), so it converges to the
+  /// unguided image; the learned trees are the same bits for any thread count or tile size.
   std::optional<bool> guiding;
   /// Guiding's settings; unset: the scene's guided_path integrator's, else the defaults.
   std::optional<GuidingSettings> guiding_settings;

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""The caustic test scenes in the repository (scenes/pool, scenes/glass-caustic) are exactly what
-scripts/make_caustic_scenes.py writes."""
+"""Scenes the repository generates are exactly what their script writes:
+    generated_scenes_test.py SCRIPT SCENE...   (scripts/SCRIPT, writing scenes/SCENE/...)"""
 import filecmp
 import os
 import subprocess
@@ -8,7 +8,7 @@ import sys
 import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-SCENES = ("pool", "glass-caustic")
+SCRIPT, SCENES = sys.argv[1], tuple(sys.argv[2:])
 
 
 def files_under(top):
@@ -16,7 +16,7 @@ def files_under(top):
 
 
 with tempfile.TemporaryDirectory() as out:
-    subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "make_caustic_scenes.py"), out], check=True,
+    subprocess.run([sys.executable, os.path.join(ROOT, "scripts", SCRIPT), out], check=True,
                    stdout=subprocess.DEVNULL)
     names, bad, extra = [], [], []
     for scene in SCENES:
@@ -30,6 +30,6 @@ with tempfile.TemporaryDirectory() as out:
             extra += [os.path.join(scene, n) for n in sorted(set(files_under(committed)) - set(written))]
     unexpected = sorted(set(os.listdir(out)) - set(SCENES))
 if bad or extra or unexpected or not names:
-    sys.exit(f"scenes/pool and scenes/glass-caustic differ from the script's output: {bad}; not made by it: "
+    sys.exit(f"scenes {', '.join(SCENES)} differ from {SCRIPT}'s output: {bad}; not made by it: "
              f"{extra}; the script also wrote: {unexpected}")
-print("caustic scenes:", ", ".join(names), "as the script makes them")
+print(f"{SCRIPT}:", ", ".join(names), "as the script makes them")
