@@ -24,6 +24,8 @@ import os
 import struct
 import sys
 
+import scene_xml
+from scene_xml import f, vec, write_text
 from texture_util import hash01, write_png
 
 # --- The pool -------------------------------------------------------------------------------------
@@ -53,11 +55,6 @@ GROUT = 0.04                  # of a tile's width
 SPHERE_RADIUS = 0.5
 GLASS_LIGHT = (-2.4, 2.6, 2.2)
 GLASS_LIGHT_INTENSITY = 40.0
-
-
-def write_text(path, text):
-    with open(path, "w", encoding="utf-8", newline="\n") as f:
-        f.write(text)
 
 
 def pool_tiles(path):
@@ -127,32 +124,8 @@ def water_ply(path):
         f.write(header.encode("ascii") + b"".join(verts) + b"".join(faces))
 
 
-def f(v):
-    """A number as the scenes write it: at most 4 decimals, no trailing zeros."""
-    s = f"{v:.4f}".rstrip("0").rstrip(".")
-    return "0" if s in ("-0", "") else s
-
-
-def vec(v):
-    return ", ".join(f(c) for c in v)
-
-
 def sensor(origin, target, fov, spp):
-    return f"""    <sensor type="perspective">
-        <float name="fov" value="{f(fov)}"/>
-        <transform name="toWorld">
-            <lookat origin="{vec(origin)}" target="{vec(target)}" up="0, 1, 0"/>
-        </transform>
-        <sampler type="independent">
-            <integer name="sampleCount" value="{spp}"/>
-        </sampler>
-        <film type="hdrfilm">
-            <integer name="width" value="320"/>
-            <integer name="height" value="180"/>
-            <rfilter type="box"/>
-        </film>
-    </sensor>
-"""
+    return scene_xml.sensor(origin, target, fov, spp, 320, 180)
 
 
 def tile_bitmap(uscale, vscale):

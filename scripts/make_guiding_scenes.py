@@ -17,9 +17,11 @@ Deterministic, standard library only, so the files in the repository are exactly
 writes (tests/integration/generated_scenes_test.py checks):
     python3 scripts/make_guiding_scenes.py [OUT_DIR]      (default: scenes)
 """
-import math
 import os
 import sys
+
+import scene_xml
+from scene_xml import f, vec, write_text
 
 WIDTH, HEIGHT = 320, 240
 MAX_DEPTH = 16
@@ -47,21 +49,6 @@ PANE_THICKNESS = 0.02
 SKY = (2.7, 3.0, 3.6)   # the uniform sky's radiance
 
 
-def write_text(path, text):
-    with open(path, "w", encoding="utf-8", newline="\n") as f:
-        f.write(text)
-
-
-def f(v):
-    """A number as the scenes write it: at most 4 decimals, no trailing zeros."""
-    s = f"{v:.4f}".rstrip("0").rstrip(".")
-    return "0" if s in ("-0", "") else s
-
-
-def vec(v):
-    return ", ".join(f(c) for c in v)
-
-
 def header(comment):
     return f"""<?xml version="1.0" encoding="utf-8"?>
 <!-- Written by scripts/make_guiding_scenes.py; do not edit. {comment} -->
@@ -73,22 +60,7 @@ def header(comment):
 
 
 def sensor(origin, target, fov, spp):
-    return f"""
-    <sensor type="perspective">
-        <float name="fov" value="{f(fov)}"/>
-        <transform name="toWorld">
-            <lookat origin="{vec(origin)}" target="{vec(target)}" up="0, 1, 0"/>
-        </transform>
-        <sampler type="independent">
-            <integer name="sampleCount" value="{spp}"/>
-        </sampler>
-        <film type="hdrfilm">
-            <integer name="width" value="{WIDTH}"/>
-            <integer name="height" value="{HEIGHT}"/>
-            <rfilter type="box"/>
-        </film>
-    </sensor>
-"""
+    return "\n" + scene_xml.sensor(origin, target, fov, spp, WIDTH, HEIGHT)
 
 
 def diffuse(id_, rgb):
@@ -111,6 +83,17 @@ def box(comment, lo, hi, material, extra_transform=""):
             <translate x="{f(centre[0])}" y="{f(centre[1])}" z="{f(centre[2])}"/>{extra_transform}
         </transform>
         {material}
+    </shape>
+"""
+
+
+def sphere(comment, centre, radius, inner):
+    return f"""
+    <!-- {comment} -->
+    <shape type="sphere">
+        <point name="center" x="{f(centre[0])}" y="{f(centre[1])}" z="{f(centre[2])}"/>
+        <float name="radius" value="{f(radius)}"/>
+        {inner}
     </shape>
 """
 
@@ -147,27 +130,13 @@ def door_ajar_scene():
                   (DOOR_THICKNESS, DOOR_TOP - 0.01, 0), '<ref id="door"/>', turn)
     shapes += box("a low cabinet in the near room", (-2.9, 0, -1.9), (-1.7, 0.8, -1.3), '<ref id="wood"/>')
     shapes += box("a table in the near room", (-1.9, 0.7, 0.2), (-0.9, 0.76, 1.4), '<ref id="wood"/>')
-    shapes += """
-    <!-- a glossy ball on the floor of the near room -->
-    <shape type="sphere">
-        <point name="center" x="-1.2" y="0.3" z="-0.8"/>
-        <float name="radius" value="0.3"/>
-        <bsdf type="roughplastic">
+    shapes += sphere("a glossy ball on the floor of the near room", (-1.2, 0.3, -0.8), 0.3, """<bsdf type="roughplastic">
             <rgb name="diffuseReflectance" value="0.5, 0.12, 0.1"/>
             <float name="alpha" value="0.15"/>
-        </bsdf>
-    </shape>
-"""
-    shapes += f"""
-    <!-- the lamp, in the far room -->
-    <shape type="sphere">
-        <point name="center" x="{f(LAMP[0])}" y="{f(LAMP[1])}" z="{f(LAMP[2])}"/>
-        <float name="radius" value="{f(LAMP_RADIUS)}"/>
-        <emitter type="area">
+        </bsdf>""")
+    shapes += sphere("the lamp, in the far room", LAMP, LAMP_RADIUS, f"""<emitter type="area">
             <rgb name="radiance" value="{vec((LAMP_RADIANCE, 0.9 * LAMP_RADIANCE, 0.75 * LAMP_RADIANCE))}"/>
-        </emitter>
-    </shape>
-"""
+        </emitter>""")
     return (header("Two rooms and a door ajar between them: the camera's room is lit only through the "
                    "door, by a small lamp in the other room (most of its light after bounces there).")
             + sensor((-2.8, 1.5, -1.75), (0.0, 0.7, 1.0), 62, 64)
@@ -196,17 +165,10 @@ def window_pane_scene():
                   (mid + PANE_THICKNESS / 2, wy1, wz1), glass)
     shapes += box("a sideboard against the back wall", (-0.6, 0, -3.0), (1.4, 0.9, -2.5), '<ref id="wood"/>')
     shapes += box("a low table", (-1.3, 0.4, -1.2), (0.1, 0.45, 0.0), '<ref id="wood"/>')
-    shapes += """
-    <!-- a metal ball on the table -->
-    <shape type="sphere">
-        <point name="center" x="-0.6" y="0.65" z="-0.6"/>
-        <float name="radius" value="0.2"/>
-        <bsdf type="roughconductor">
+    shapes += sphere("a metal ball on the table", (-0.6, 0.65, -0.6), 0.2, """<bsdf type="roughconductor">
             <string name="material" value="Au"/>
             <float name="alpha" value="0.2"/>
-        </bsdf>
-    </shape>
-"""
+        </bsdf>""")
     shapes += f"""
     <!-- the sky: seen only through the pane -->
     <emitter type="constant">

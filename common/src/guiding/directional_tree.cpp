@@ -40,7 +40,7 @@ Vec2 direction_to_square(Vec3 dir) {
   return {std::min(x, kBelowOne), std::clamp(y, 0.f, kBelowOne)};
 }
 
-DirectionalTree::DirectionalTree() : nodes_(1) {}
+DirectionalTree::DirectionalTree() : nodes_(1), density_(1, {1.f, 1.f, 1.f, 1.f}) {}
 
 int DirectionalTree::quadrant(Vec2& p) {
   // (Exact in floating point: doubling, and subtracting 1 from a number in [1, 2).)
@@ -60,13 +60,12 @@ int DirectionalTree::quadrant(Vec2& p) {
   return i;
 }
 
-void DirectionalTree::record(Vec3 dir, float value, float dither) {
+void DirectionalTree::record_at(Vec2 p, float value, float dither) {
   if (!(value > 0.f)) return;  // (NaN too)
   const double scaled = double(std::min(value, kMaxRecord)) * double(uint64_t(1) << kScaleBits);
   uint64_t q = uint64_t(scaled);
   if (double(dither) < scaled - double(q)) ++q;  // rounds up with probability equal to the fraction
   if (q == 0) return;
-  Vec2 p = direction_to_square(dir);
   for (uint32_t n = 0;;) {
     const int i = quadrant(p);
     const uint32_t c = nodes_[n].child[i];
@@ -96,7 +95,19 @@ uint64_t DirectionalTree::build_node(uint32_t n) {
   return total;
 }
 
-void DirectionalTree::build() { (void)build_node(0); }
+void DirectionalTree::build() {
+  (void)build_node(0);
+  set_densities();
+}
+
+void DirectionalTree::set_densities() {
+  density_.resize(nodes_.size());
+  for (size_t n = 0; n < nodes_.size(); ++n) {
+    const std::array<uint64_t, 4>& s = nodes_[n].sum;
+    const double total = double(s[0]) + double(s[1]) + double(s[2]) + double(s[3]);
+    for (int i = 0; i < 4; ++i) density_[n][size_t(i)] = total > 0.0 ? float(4.0 * double(s[size_t(i)]) / total) : 1.f;
+  }
+}
 
 uint64_t DirectionalTree::total() const {
   uint64_t total = 0;
@@ -104,7 +115,7 @@ uint64_t DirectionalTree::total() const {
   return total;
 }
 
-Vec3 DirectionalTree::sample(Vec2 u, float& pdf) const {
+Vec3 DirectionalTree::sample(Vec2 u, float& pdf, Vec2* square) const {
   double ux = std::min(double(u.x), kOneBelow), uy = std::min(double(u.y), kOneBelow);
   double density = 1.0, x0 = 0.0, y0 = 0.0, size = 1.0;
   for (uint32_t n = 0;;) {
@@ -123,22 +134,23 @@ Vec3 DirectionalTree::sample(Vec2 u, float& pdf) const {
     if (n == 0) break;
   }
   pdf = float(density * (0.25 * kInvPi));
-  return square_to_uniform_sphere(Vec2(float(x0 + ux * size), float(y0 + uy * size)));
+  // (Clamped below 1 like direction_to_square, so the point stays in the cell it was drawn in.)
+  constexpr float kBelowOne = 1.f - std::numeric_limits<float>::epsilon() / 2;
+  const Vec2 p(std::min(float(x0 + ux * size), kBelowOne), std::min(float(y0 + uy * size), kBelowOne));
+  if (square) *square = p;
+  return square_to_uniform_sphere(p);
 }
 
-float DirectionalTree::pdf(Vec3 dir) const {
-  Vec2 p = direction_to_square(dir);
-  double density = 1.0;
+float DirectionalTree::pdf_at(Vec2 p) const {
+  TESSERA_DCHECK(density_.size() == nodes_.size());
+  float density = 1.f;
   for (uint32_t n = 0;;) {
-    const std::array<uint64_t, 4>& s = nodes_[n].sum;
-    const double total = double(s[0]) + double(s[1]) + double(s[2]) + double(s[3]);
-    if (!(total > 0.0)) break;
     const int i = quadrant(p);
-    density *= 4.0 * double(s[i]) / total;
+    density *= density_[n][size_t(i)];
     n = nodes_[n].child[i];
     if (n == 0) break;
   }
-  return float(density * (0.25 * kInvPi));
+  return density * (0.25f * kInvPi);
 }
 
 void DirectionalTree::refine_into(DirectionalTree& out, uint32_t out_node, const Node* node, double scale,
@@ -165,6 +177,7 @@ DirectionalTree DirectionalTree::refined(double threshold, bool keep_sums) const
   DirectionalTree out;
   const double total = double(this->total());
   if (total > 0.0) refine_into(out, 0, &nodes_[0], 1.0 / total, 0, 1, threshold, keep_sums);
+  out.set_densities();  // (of its sums so far; build() makes them again, and every tree holds them)
   return out;
 }
 

@@ -35,10 +35,10 @@ uint32_t SpatialTree::leaf_of(Vec3 p) const {
   return nodes_[n].leaf;
 }
 
-void SpatialTree::record(uint32_t leaf, Vec3 dir, float value, float dither) {
+void SpatialTree::record_at(uint32_t leaf, Vec2 square, float value, float dither) {
   Leaf& l = leaves_[leaf];
   std::atomic_ref<uint64_t>(l.samples).fetch_add(1, std::memory_order_relaxed);
-  l.building.record(dir, value, dither);
+  l.building.record_at(square, value, dither);
 }
 
 size_t SpatialTree::leaf_bytes(const Leaf& leaf) {

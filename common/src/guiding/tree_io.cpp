@@ -89,6 +89,7 @@ struct TreeIo {
         if (c = r.get<uint32_t>(); c != 0 && (c <= i || c >= count)) return false;
       for (uint64_t& s : n.sum) s = r.get<uint64_t>();
     }
+    t.set_densities();
     return r.ok;
   }
   static void write(Writer& w, const BsdfFractionLoss& l) {

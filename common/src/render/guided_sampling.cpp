@@ -6,8 +6,10 @@ namespace tessera {
 
 namespace {
 
-MixturePdfs mixture_pdfs(const Bsdf& bsdf, const SurfaceInteraction& si, Vec3 wo, Vec3 wi, const DirectionalTree& guide) {
-  return {bsdf.pdf(si, wo, wi), guide.pdf(si.to_world(wi))};
+// At `square`, the point of wi on the guide's square.
+MixturePdfs mixture_pdfs(const Bsdf& bsdf, const SurfaceInteraction& si, Vec3 wo, Vec3 wi, Vec2 square,
+                         const DirectionalTree& guide) {
+  return {bsdf.pdf(si, wo, wi), guide.pdf_at(square), square};
 }
 
 float mix(const MixturePdfs& p, float bsdf_fraction) {
@@ -18,11 +20,12 @@ float mix(const MixturePdfs& p, float bsdf_fraction) {
 
 float guided_pdf(const Bsdf& bsdf, const SurfaceInteraction& si, Vec3 wo, Vec3 wi, const DirectionalTree& guide,
                  float bsdf_fraction) {
-  return mix(mixture_pdfs(bsdf, si, wo, wi, guide), bsdf_fraction);
+  return mix(mixture_pdfs(bsdf, si, wo, wi, direction_to_square(si.to_world(wi)), guide), bsdf_fraction);
 }
 
 bool sample_guided(const Bsdf& bsdf, const SurfaceInteraction& si, Vec3 wo, const DirectionalTree& guide,
                    float bsdf_fraction, float u_lobe, Vec2 u_dir, BsdfSample& out, MixturePdfs* parts) {
+  Vec2 square;
   if (u_lobe < bsdf_fraction) {
     // (u_lobe / bsdf_fraction is uniform in [0,1) again: the BSDF's own lobe choice.)
     const float u = std::min(u_lobe / bsdf_fraction, 1.f - 0x1p-24f);
@@ -32,14 +35,16 @@ bool sample_guided(const Bsdf& bsdf, const SurfaceInteraction& si, Vec3 wo, cons
       out.weight *= 1.f / bsdf_fraction;
       return true;
     }
+    square = direction_to_square(si.to_world(out.wi));
   } else {
-    float guide_pdf = 0.f;  // (not used: the mixture's pdf is evaluated for the direction as it
-                            // lies after rounding, as next-event estimation's MIS evaluates it)
-    out.wi = si.to_local(guide.sample(u_dir, guide_pdf));
+    // The guide's density at the point it drew, not at the direction mapped back (which differs
+    // only where rounding crosses a cell's edge, and would cost an arc tangent).
+    float guide_pdf = 0.f;
+    out.wi = si.to_local(guide.sample(u_dir, guide_pdf, &square));
     out.eta = 1.f;
     out.delta = false;
   }
-  const MixturePdfs pdfs = mixture_pdfs(bsdf, si, wo, out.wi, guide);
+  const MixturePdfs pdfs = mixture_pdfs(bsdf, si, wo, out.wi, square, guide);
   if (parts) *parts = pdfs;
   out.pdf = mix(pdfs, bsdf_fraction);
   if (!(out.pdf > 0.f)) return false;

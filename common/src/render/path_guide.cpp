@@ -13,7 +13,7 @@ void GuideRecords::commit(SpatialTree& tree, const Rgb& radiance, Sampler& sampl
     // (A path that ended at the vertex, or carries nothing further, still counts as a sample.)
     const float li = through > 0.f ? std::max(0.f, (radiance - v.radiance).luminance()) / through : 0.f;
     const float value = v.pdf > 0.f ? li / v.pdf : 0.f;
-    tree.record(v.leaf, v.wi, value, sampler.sample_1d_at(kDitherDimension + uint32_t(k)));
+    tree.record_at(v.leaf, v.square, value, sampler.sample_1d_at(kDitherDimension + uint32_t(k)));
     if (v.mixture) tree.record_fraction(v.leaf, value * v.f_cos, v.mixture->bsdf, v.mixture->guide);
   }
 }

@@ -210,10 +210,11 @@ class PathIntegrator final : public Integrator {
     path.prev_ctx = {si.p, si.shading.n};
     ++path.depth;
     if (media) path.medium = medium_after(si, wi_world, path.medium);
-    // Guided: where the guide expects more light than its region's average, the path is worth
-    // that much more than its throughput says.
-    const float brighter = guide && !bs.delta && path.guide->guided_roulette ? std::max(1.f, 4.f * kPi * mixture.guide) : 1.f;
-    if (!survives_roulette(path.depth, path.throughput, path.eta, u.u_rr, brighter)) return false;
+    // (Müller's rule, asked for: once the guide samples, guided and delta vertices keep their paths.)
+    const bool keep = path.guide && path.guide->sample && path.guide->guided_roulette;
+    if (!(keep ? survives_guided_roulette(path.depth, u.u_rr, path.throughput)
+               : survives_roulette(path.depth, path.throughput, path.eta, u.u_rr)))
+      return false;
     path.ray = spawn_ray(si, wi_world);
     ++counters.bounce_rays;
     return true;
@@ -238,15 +239,23 @@ class PathIntegrator final : public Integrator {
   }
 
   // Russian roulette as Mitsuba 3: survival probability from the throughput, times eta^2 so that
-  // refraction's radiance scaling does not kill paths inside glass early; capped at 0.95. With
-  // guided roulette, also times how much brighter than its average the guide expects the sampled
-  // direction to be (`brighter`: 4π times the guide's pdf there, at least 1): a guided direction
-  // toward bright light has a small f·cos/p, which the throughput alone would end.
-  bool survives_roulette(int depth, Rgb& throughput, float eta, float u_rr, float brighter = 1.f) const {
+  // refraction's radiance scaling does not kill paths inside glass early; capped at 0.95.
+  bool survives_roulette(int depth, Rgb& throughput, float eta, float u_rr) const {
     if (depth >= s_.rr_depth) {
-      float q = std::min(throughput.max_value() * eta * eta * brighter, 0.95f);
+      float q = std::min(throughput.max_value() * eta * eta, 0.95f);
       if (!(u_rr < q)) return false;
       throughput *= 1.f / q;
+    }
+    return !throughput.is_black();
+  }
+
+  // Müller et al.'s guided roulette (their code): survival 0.99 whatever the throughput, which a
+  // guided direction toward bright light makes small.
+  bool survives_guided_roulette(int depth, float u_rr, Rgb& throughput) const {
+    constexpr float kSurvival = 0.99f;
+    if (depth >= s_.rr_depth) {
+      if (!(u_rr < kSurvival)) return false;
+      throughput *= 1.f / kSurvival;
     }
     return !throughput.is_black();
   }

@@ -43,16 +43,22 @@ class DirectionalTree {
 
   /// Adds `value` (>= 0; others are ignored) at `dir`. `dither` in [0,1) decides the rounding.
   /// Thread-safe against other record() calls; not against build() or merge().
-  void record(Vec3 dir, float value, float dither);
+  void record(Vec3 dir, float value, float dither) { record_at(direction_to_square(dir), value, dither); }
+  /// The same at the direction's point on the square (direction_to_square, or where sample() drew it).
+  void record_at(Vec2 square, float value, float dither);
   /// Adds the sums of a tree of the same structure (the same refined() ancestry).
   void merge(const DirectionalTree& other);
   /// Makes the inner quadrants' sums the totals of their subtrees. Before sampling.
   void build();
 
-  /// Draws a direction; `pdf` is its solid-angle density (a tree without energy is uniform).
-  Vec3 sample(Vec2 u, float& pdf) const;
+  /// Draws a direction; `pdf` is its solid-angle density (a tree without energy is uniform), and
+  /// `square` (if given) the point on the square it was drawn at, which pdf_at() and record_at()
+  /// take without mapping the direction back (its arc tangent is most of that map's cost).
+  Vec3 sample(Vec2 u, float& pdf, Vec2* square = nullptr) const;
   /// Solid-angle density of sample() at `dir`.
-  float pdf(Vec3 dir) const;
+  float pdf(Vec3 dir) const { return pdf_at(direction_to_square(dir)); }
+  /// The same at a point of the square.
+  float pdf_at(Vec2 square) const;
 
   /// The next iteration's tree (of a built tree): a quadrant whose share of the total energy is
   /// above `threshold` is split (to at most kMaxDepth), a subtree whose share is not is merged. A
@@ -66,7 +72,7 @@ class DirectionalTree {
   /// All energy recorded (after build()), in fixed-point units.
   uint64_t total() const;
   size_t node_count() const { return nodes_.size(); }
-  size_t bytes() const { return sizeof(*this) + nodes_.size() * sizeof(Node); }
+  size_t bytes() const { return sizeof(*this) + nodes_.size() * sizeof(Node) + density_.size() * sizeof(density_[0]); }
   int depth() const;
   /// The sums and structure compare equal.
   bool operator==(const DirectionalTree& other) const;
@@ -79,11 +85,16 @@ class DirectionalTree {
   // Quadrant i covers x in [i&1 ? 0.5 : 0, ...) and y in [i&2 ? 0.5 : 0, ...) of its node.
   static int quadrant(Vec2& p);
   uint64_t build_node(uint32_t n);
+  void set_densities();
   friend struct TreeIo;  // tree_io.h
   void refine_into(DirectionalTree& out, uint32_t out_node, const Node* node, double scale, uint64_t energy,
                    int depth, double threshold, bool keep_sums) const;
 
   std::vector<Node> nodes_;
+  // Per node, each quadrant's factor of the density on the square, 4 x its share of the node's
+  // energy (1 in a node without energy): pdf_at() multiplies them along its descent instead of
+  // dividing sums. Made by build() and when a tree is read; a tree that samples has them.
+  std::vector<std::array<float, 4>> density_;
 };
 
 }  // namespace tessera

@@ -13,9 +13,11 @@
 
 namespace tessera {
 
-/// The two densities the mixture combines at a sampled direction (solid angle).
+/// The two densities the mixture combines at a sampled direction (solid angle), and the
+/// direction's point on the guide's square (DirectionalTree), where a training record goes.
 struct MixturePdfs {
   float bsdf = 0.f, guide = 0.f;
+  Vec2 square;
 };
 
 /// Samples `out` (wi in the local frame of `si`) from the mixture; false when nothing was sampled.

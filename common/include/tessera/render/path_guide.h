@@ -30,8 +30,8 @@ struct PathGuide {
   SpatialTree* records = nullptr;     // where training records go: `tree`, or a recorder of it (tree_io.h)
   bool sample = false;                // guide directions with the tree's learned distributions
   bool train = false;                 // record the pass's radiance into `records`
-  /// Where the guide samples, paths survive Russian roulette with probability 0.99
-  /// (GuideRoulette::Guided) rather than by their throughput.
+  /// Once the guide samples, paths survive Russian roulette with probability 0.99
+  /// (GuideRoulette::Guided, Müller's) rather than by their throughput.
   bool guided_roulette = false;
 };
 
@@ -49,7 +49,10 @@ class GuideRecords {
   /// vertex (none when the guide did not sample).
   void add(uint32_t leaf, Vec3 wi, float pdf, float f_cos, std::optional<MixturePdfs> mixture, const Rgb& throughput,
            const Rgb& radiance) {
-    if (count_ < kCapacity) vertices_[size_t(count_++)] = {leaf, wi, pdf, f_cos, mixture, throughput, radiance};
+    if (count_ >= kCapacity) return;
+    // (A guided vertex knows where wi lies on the guide's square; otherwise it is mapped here.)
+    const Vec2 square = mixture ? mixture->square : direction_to_square(wi);
+    vertices_[size_t(count_++)] = {leaf, square, pdf, f_cos, mixture, throughput, radiance};
   }
   /// Records every vertex into `tree` once the path's estimate is `radiance`.
   void commit(SpatialTree& tree, const Rgb& radiance, Sampler& sampler) const;
@@ -57,7 +60,7 @@ class GuideRecords {
  private:
   struct Vertex {
     uint32_t leaf;
-    Vec3 wi;
+    Vec2 square;  // wi's point on the guide's square
     float pdf, f_cos;
     std::optional<MixturePdfs> mixture;
     Rgb throughput, radiance;
