@@ -126,9 +126,8 @@ TileResult render_lease(const Scene& scene, const Lease& lease, const SpatialTre
   if (lease.guide) {
     // (The job's guide settings are the scene's, as guide_plan() made them at submission.)
     const std::optional<GuidePlan> plan = guide_plan(scene, true);
-    const bool guided_roulette = plan && plan->settings.roulette == GuideRoulette::Guided;
     path_guide = PathGuide{guide, recorder ? &*recorder : nullptr, lease.guide->iteration > 0, lease.guide->train,
-                           guided_roulette};
+                           plan ? plan->settings.roulette : GuideRoulette::Throughput};
   }
   // A denoised job's units, or one's with AOV layers, also sum the AOVs.
   render_tile(scene, lease.rect, samples, lease.settings.seed, result.film, path_guide ? &*path_guide : nullptr,
@@ -266,9 +265,8 @@ JobPlan::Guide guide_from_json(const json& j) {
   const std::string combination = j.value("combination", guide_combination_name(GuideCombination::Discard));
   const std::string roulette = j.value("roulette", guide_roulette_name(GuideRoulette::Throughput));
   if (combination != "discard" && combination != "inversevar") throw std::invalid_argument("guide combination");
-  if (roulette != "throughput" && roulette != "guided") throw std::invalid_argument("guide roulette");
+  if (!parse_guide_roulette(roulette, s.roulette)) throw std::invalid_argument("guide roulette");
   s.combination = combination == "discard" ? GuideCombination::Discard : GuideCombination::InverseVariance;
-  s.roulette = roulette == "throughput" ? GuideRoulette::Throughput : GuideRoulette::Guided;
   s.combined_iterations = j.value("combined_iterations", 4);
   if (s.combined_iterations < 1) throw std::invalid_argument("guide combined_iterations");
   return g;

@@ -95,6 +95,19 @@ TEST(DirectionalTree, SamplesFollowThePdfOfATrainedTree) {
   EXPECT_NEAR(r.pdf_integral, 1.0, 1e-2);
 }
 
+// A guided sample takes the density sample() returns for the mixture, without descending again.
+TEST(DirectionalTree, TheSampledDensityIsThePdfAtTheDrawnPointBitForBit) {
+  const DirectionalTree tree = trained(3, 200000);
+  Pcg32 rng(5);
+  for (int k = 0; k < 100000; ++k) {
+    float pdf = 0.f;
+    Vec2 square;
+    const Vec3 d = tree.sample(Vec2(rng.next_float(), rng.next_float()), pdf, &square);
+    ASSERT_EQ(pdf, tree.pdf_at(square)) << k;
+    ASSERT_NEAR(length(d - square_to_uniform_sphere(square)), 0.f, 1e-6f);
+  }
+}
+
 TEST(DirectionalTree, TheGuidedPdfFollowsTheRecordedEnergy) {
   const DirectionalTree tree = trained(3, 200000);
   const Vec3 axis = normalize(Vec3(0.3f, -0.5f, 0.8f));

@@ -88,6 +88,29 @@ TEST(SpatialTree, TheSameRecordsInAnyOrderGiveTheSameTree) {
   EXPECT_GT(serial.leaf_count(), 8u);
 }
 
+// Adjoint-driven roulette reads them: the incident luminance over the sphere, the mean of the
+// recorded values (each is Li / pdf), and the mean pixel sample; a split leaf's halves keep them.
+TEST(SpatialTree, AnIterationLeavesEachLeafItsRadianceAndPixelEstimates) {
+  GuidingSettings s;
+  s.spatial_threshold = 2;  // (splits the leaf at the end of the iteration)
+  SpatialTree tree(unit_box());
+  const uint32_t leaf = tree.leaf_of(Vec3(0.3f));
+  // Values exact in the fixed point: no rounding, so the estimates are exact too.
+  for (float v : {1.f, 2.f, 0.f, 5.f}) tree.record(leaf, Vec3(0.f, 0.f, 1.f), v, 0.5f);
+  for (float v : {0.25f, 0.75f}) tree.record_pixel(leaf, v, 0.5f);
+  EXPECT_EQ(tree.radiance(leaf), 0.f) << "nothing before the iteration ends";
+  tree.end_iteration(4, s);
+  ASSERT_GT(tree.leaf_count(), 1u);
+  for (Vec3 p : {Vec3(0.1f), Vec3(0.9f)}) {
+    EXPECT_EQ(tree.radiance(tree.leaf_of(p)), 2.f);
+    EXPECT_EQ(tree.pixel(tree.leaf_of(p)), 0.5f);
+  }
+  // Each iteration's own: the next one, without records, knows nothing.
+  tree.end_iteration(8, s);
+  EXPECT_EQ(tree.radiance(tree.leaf_of(Vec3(0.3f))), 0.f);
+  EXPECT_EQ(tree.pixel(tree.leaf_of(Vec3(0.3f))), 0.f);
+}
+
 TEST(SpatialTree, NothingIsSplitBeyondTheMemoryCap) {
   GuidingSettings s;
   s.spatial_threshold = 10;

@@ -19,6 +19,7 @@ void record_some(SpatialTree& tree, int n, uint64_t seed) {
     tree.record(leaf, square_to_uniform_sphere(Vec2(rng.next_float(), rng.next_float())), rng.next_float() * 10.f,
                 rng.next_float());
     tree.record_fraction(leaf, rng.next_float(), rng.next_float(), rng.next_float());
+    if (k % 3 == 0) tree.record_pixel(leaf, rng.next_float() * 2.f, rng.next_float());
   }
 }
 

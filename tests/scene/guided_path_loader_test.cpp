@@ -43,6 +43,7 @@ TEST(GuidedPathLoader, MapsThePluginsParameters) {
 <float name="dTreeThreshold" value="0.02"/>
 <integer name="sdTreeMaxMemory" value="64"/>
 <string name="nee" value="always"/>
+<string name="roulette" value="guided"/>
 <integer name="maxDepth" value="5"/>
 )");
   const IntegratorSettings& s = r.scene->integrator;
@@ -51,6 +52,7 @@ TEST(GuidedPathLoader, MapsThePluginsParameters) {
   ASSERT_TRUE(s.guiding.has_value());
   EXPECT_TRUE(s.guiding->learn_bsdf_fraction);
   EXPECT_EQ(s.guiding->combination, GuideCombination::Discard);
+  EXPECT_EQ(s.guiding->roulette, GuideRoulette::Guided);
   EXPECT_FLOAT_EQ(s.guiding->bsdf_fraction, 0.4f);
   EXPECT_DOUBLE_EQ(s.guiding->spatial_threshold, 4000);
   EXPECT_NEAR(s.guiding->directional_threshold, 0.02, 1e-7);
@@ -90,6 +92,7 @@ TEST(GuidedPathLoader, OutOfRangeValuesNameTheLineAndParameter) {
       {"<integer name=\"sdTreeMaxMemory\" value=\"0\"/>\n", "sd_tree_max_memory"},
       {"<string name=\"spatialFilter\" value=\"gaussian\"/>\n", "spatial_filter"},
       {"<float name=\"budget\" value=\"0\"/>\n", "budget"},
+      {"<string name=\"roulette\" value=\"adjoint\"/>\n", "roulette"},
   };
   for (const auto& [param, name] : cases) {
     const std::string e = error_of(kSpp + param);

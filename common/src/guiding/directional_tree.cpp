@@ -29,6 +29,14 @@ bool pick_upper(double& u, double p_low) {
   return true;
 }
 
+// A point of the square in 32-bit fixed point: bit 31 - d of each coordinate is the half it lies in
+// at depth d (exact: a float below 1 times 2^32 is an integer plus an exact fraction).
+struct SquareBits {
+  explicit SquareBits(Vec2 p) : x(uint32_t(double(p.x) * 0x1p32)), y(uint32_t(double(p.y) * 0x1p32)) {}
+  int quadrant(int depth) const { return int((x >> (31 - depth)) & 1u) | int(((y >> (31 - depth)) & 1u) << 1); }
+  uint32_t x, y;
+};
+
 }  // namespace
 
 Vec2 direction_to_square(Vec3 dir) {
@@ -40,37 +48,24 @@ Vec2 direction_to_square(Vec3 dir) {
   return {std::min(x, kBelowOne), std::clamp(y, 0.f, kBelowOne)};
 }
 
-DirectionalTree::DirectionalTree() : nodes_(1), density_(1, {1.f, 1.f, 1.f, 1.f}) {}
+DirectionalTree::DirectionalTree() : nodes_(1), cells_(1) {}
 
-int DirectionalTree::quadrant(Vec2& p) {
-  // (Exact in floating point: doubling, and subtracting 1 from a number in [1, 2).)
-  int i = 0;
-  if (p.x < 0.5f) {
-    p.x *= 2.f;
-  } else {
-    p.x = 2.f * p.x - 1.f;
-    i |= 1;
-  }
-  if (p.y < 0.5f) {
-    p.y *= 2.f;
-  } else {
-    p.y = 2.f * p.y - 1.f;
-    i |= 2;
-  }
-  return i;
+uint64_t DirectionalTree::fixed_point(float value, float dither) {
+  if (!(value > 0.f)) return 0;  // (NaN too)
+  const double scaled = double(std::min(value, kMaxRecord)) * double(uint64_t(1) << kScaleBits);
+  const uint64_t q = uint64_t(scaled);
+  return double(dither) < scaled - double(q) ? q + 1 : q;
 }
 
 void DirectionalTree::record_at(Vec2 p, float value, float dither) {
-  if (!(value > 0.f)) return;  // (NaN too)
-  const double scaled = double(std::min(value, kMaxRecord)) * double(uint64_t(1) << kScaleBits);
-  uint64_t q = uint64_t(scaled);
-  if (double(dither) < scaled - double(q)) ++q;  // rounds up with probability equal to the fraction
+  const uint64_t q = fixed_point(value, dither);
   if (q == 0) return;
-  for (uint32_t n = 0;;) {
-    const int i = quadrant(p);
-    const uint32_t c = nodes_[n].child[i];
+  const SquareBits bits(p);
+  for (uint32_t n = 0, depth = 0;; ++depth) {
+    const int i = bits.quadrant(int(depth));
+    const uint32_t c = cells_[n].child[size_t(i)];
     if (c == 0) {
-      std::atomic_ref<uint64_t>(nodes_[n].sum[i]).fetch_add(q, std::memory_order_relaxed);
+      std::atomic_ref<uint64_t>(nodes_[n].sum[size_t(i)]).fetch_add(q, std::memory_order_relaxed);
       return;
     }
     n = c;
@@ -97,15 +92,16 @@ uint64_t DirectionalTree::build_node(uint32_t n) {
 
 void DirectionalTree::build() {
   (void)build_node(0);
-  set_densities();
+  set_cells();
 }
 
-void DirectionalTree::set_densities() {
-  density_.resize(nodes_.size());
+void DirectionalTree::set_cells() {
+  cells_.resize(nodes_.size());
   for (size_t n = 0; n < nodes_.size(); ++n) {
     const std::array<uint64_t, 4>& s = nodes_[n].sum;
     const double total = double(s[0]) + double(s[1]) + double(s[2]) + double(s[3]);
-    for (int i = 0; i < 4; ++i) density_[n][size_t(i)] = total > 0.0 ? float(4.0 * double(s[size_t(i)]) / total) : 1.f;
+    for (size_t i = 0; i < 4; ++i) cells_[n].density[i] = total > 0.0 ? float(4.0 * double(s[i]) / total) : 1.f;
+    cells_[n].child = nodes_[n].child;
   }
 }
 
@@ -116,24 +112,23 @@ uint64_t DirectionalTree::total() const {
 }
 
 Vec3 DirectionalTree::sample(Vec2 u, float& pdf, Vec2* square) const {
+  // The same factors as pdf_at() in the same order, so the density is the same bits there.
   double ux = std::min(double(u.x), kOneBelow), uy = std::min(double(u.y), kOneBelow);
-  double density = 1.0, x0 = 0.0, y0 = 0.0, size = 1.0;
+  double x0 = 0.0, y0 = 0.0, size = 1.0;
+  float density = 1.f;
   for (uint32_t n = 0;;) {
-    const std::array<uint64_t, 4>& s = nodes_[n].sum;
-    const double total = double(s[0]) + double(s[1]) + double(s[2]) + double(s[3]);
-    if (!(total > 0.0)) break;  // no energy below: uniform over the node
-    // The column (x half) by its marginal, then the row within it.
-    int i = pick_upper(ux, (double(s[0]) + double(s[2])) / total) ? 1 : 0;
-    const double column = double(s[i]) + double(s[i + 2]);
-    if (pick_upper(uy, double(s[i]) / column)) i |= 2;
-    density *= 4.0 * double(s[i]) / total;
+    const std::array<float, 4>& d = cells_[n].density;
+    // The column (x half) by its marginal, then the row within it (a zero share is never taken).
+    int i = pick_upper(ux, double(d[0] + d[2]) / double(d[0] + d[1] + d[2] + d[3])) ? 1 : 0;
+    if (pick_upper(uy, double(d[size_t(i)]) / double(d[size_t(i)] + d[size_t(i) + 2]))) i |= 2;
+    density *= d[size_t(i)];
     size *= 0.5;
     x0 += (i & 1) ? size : 0.0;
     y0 += (i & 2) ? size : 0.0;
-    n = nodes_[n].child[i];
+    n = cells_[n].child[size_t(i)];
     if (n == 0) break;
   }
-  pdf = float(density * (0.25 * kInvPi));
+  pdf = density * (0.25f * kInvPi);
   // (Clamped below 1 like direction_to_square, so the point stays in the cell it was drawn in.)
   constexpr float kBelowOne = 1.f - std::numeric_limits<float>::epsilon() / 2;
   const Vec2 p(std::min(float(x0 + ux * size), kBelowOne), std::min(float(y0 + uy * size), kBelowOne));
@@ -142,12 +137,13 @@ Vec3 DirectionalTree::sample(Vec2 u, float& pdf, Vec2* square) const {
 }
 
 float DirectionalTree::pdf_at(Vec2 p) const {
-  TESSERA_DCHECK(density_.size() == nodes_.size());
+  TESSERA_DCHECK(cells_.size() == nodes_.size());
+  const SquareBits bits(p);
   float density = 1.f;
-  for (uint32_t n = 0;;) {
-    const int i = quadrant(p);
-    density *= density_[n][size_t(i)];
-    n = nodes_[n].child[i];
+  for (uint32_t n = 0, depth = 0;; ++depth) {
+    const int i = bits.quadrant(int(depth));
+    density *= cells_[n].density[size_t(i)];
+    n = cells_[n].child[size_t(i)];
     if (n == 0) break;
   }
   return density * (0.25f * kInvPi);
@@ -177,7 +173,7 @@ DirectionalTree DirectionalTree::refined(double threshold, bool keep_sums) const
   DirectionalTree out;
   const double total = double(this->total());
   if (total > 0.0) refine_into(out, 0, &nodes_[0], 1.0 / total, 0, 1, threshold, keep_sums);
-  out.set_densities();  // (of its sums so far; build() makes them again, and every tree holds them)
+  out.set_cells();  // (of its sums so far; build() makes them again, and every tree holds them)
   return out;
 }
 

@@ -19,18 +19,26 @@ SpatialTree::SpatialTree(const Bounds3& bounds, float bsdf_fraction) : nodes_(1)
   nodes_[0].leaf = 0;
 }
 
+namespace {
+
+// A coordinate of the cube's [0,1] in 64-bit fixed point: bit 63 - k is the half it lies in at the
+// k-th cut of its axis (as repeated doubling would find; 1 stays in the upper halves).
+uint64_t cube_bits(float x) {
+  if (!(x < 1.f)) return x >= 1.f ? ~uint64_t(0) : uint64_t(1) << 63;  // (NaN: the middle)
+  return x > 0.f ? uint64_t(double(x) * 0x1p64) : 0;
+}
+
+}  // namespace
+
 uint32_t SpatialTree::leaf_of(Vec3 p) const {
-  // Position within the cube in [0,1]^3; each level doubles the coordinate it cuts.
   const Vec3 size = bounds_.diagonal();
-  Vec3 u((p.x - bounds_.lo.x) / size.x, (p.y - bounds_.lo.y) / size.y, (p.z - bounds_.lo.z) / size.z);
-  float c[3] = {std::clamp(u.x, 0.f, 1.f), std::clamp(u.y, 0.f, 1.f), std::clamp(u.z, 0.f, 1.f)};
-  if (!(c[0] == c[0]) || !(c[1] == c[1]) || !(c[2] == c[2])) c[0] = c[1] = c[2] = 0.5f;  // (NaN)
+  const uint64_t bits[3] = {cube_bits((p.x - bounds_.lo.x) / size.x), cube_bits((p.y - bounds_.lo.y) / size.y),
+                            cube_bits((p.z - bounds_.lo.z) / size.z)};
   uint32_t n = 0;
-  for (int depth = 0; nodes_[n].leaf == kNoLeaf; ++depth) {
-    float& x = c[depth % 3];
-    const bool upper = x >= 0.5f;
-    x = upper ? 2.f * x - 1.f : 2.f * x;
+  for (uint32_t axis = 0, cut = 0; nodes_[n].leaf == kNoLeaf;) {
+    const bool upper = cut < 64 && ((bits[axis] >> (63 - cut)) & 1u);
     n = nodes_[n].child[upper ? 1 : 0];
+    if (++axis == 3) axis = 0, ++cut;
   }
   return nodes_[n].leaf;
 }
@@ -39,6 +47,13 @@ void SpatialTree::record_at(uint32_t leaf, Vec2 square, float value, float dithe
   Leaf& l = leaves_[leaf];
   std::atomic_ref<uint64_t>(l.samples).fetch_add(1, std::memory_order_relaxed);
   l.building.record_at(square, value, dither);
+}
+
+void SpatialTree::record_pixel(uint32_t leaf, float value, float dither) {
+  Leaf& l = leaves_[leaf];
+  std::atomic_ref<uint64_t>(l.pixel_paths).fetch_add(1, std::memory_order_relaxed);
+  if (const uint64_t q = DirectionalTree::fixed_point(value, dither))
+    std::atomic_ref<uint64_t>(l.pixel_sum).fetch_add(q, std::memory_order_relaxed);
 }
 
 size_t SpatialTree::leaf_bytes(const Leaf& leaf) {
@@ -69,7 +84,23 @@ const char* guide_combination_name(GuideCombination c) {
   return c == GuideCombination::Discard ? "discard" : "inversevar";
 }
 
-const char* guide_roulette_name(GuideRoulette r) { return r == GuideRoulette::Throughput ? "throughput" : "guided"; }
+const char* guide_roulette_name(GuideRoulette r) {
+  switch (r) {
+    case GuideRoulette::Throughput: return "throughput";
+    case GuideRoulette::Guided: return "guided";
+    case GuideRoulette::Radiance: break;
+  }
+  return "radiance";
+}
+
+bool parse_guide_roulette(const std::string& name, GuideRoulette& out) {
+  for (GuideRoulette r : {GuideRoulette::Throughput, GuideRoulette::Guided, GuideRoulette::Radiance})
+    if (name == guide_roulette_name(r)) {
+      out = r;
+      return true;
+    }
+  return false;
+}
 
 double spatial_split_threshold(const GuidingSettings& settings, uint32_t iteration_spp) {
   return settings.spatial_threshold * std::sqrt(double(iteration_spp) / 4.0);
@@ -77,6 +108,14 @@ double spatial_split_threshold(const GuidingSettings& settings, uint32_t iterati
 
 void SpatialTree::end_iteration(uint32_t iteration_spp, const GuidingSettings& settings) {
   const double threshold = spatial_split_threshold(settings, iteration_spp);
+  // The estimates first: a split leaf's halves keep its trees whole but half its samples.
+  for (Leaf& l : leaves_) {
+    l.building.build();
+    const double samples = double(l.samples), paths = double(l.pixel_paths);
+    l.radiance = samples > 0.0 ? float(DirectionalTree::from_fixed_point(double(l.building.total())) / samples) : 0.f;
+    l.pixel = paths > 0.0 ? float(DirectionalTree::from_fixed_point(double(l.pixel_sum)) / paths) : 0.f;
+    l.pixel_sum = l.pixel_paths = 0;
+  }
   size_t total = bytes();
   // In index order, children right after they are made: a half that still has too many samples
   // is split again. The order, and so the result, depends only on the counts.
@@ -90,7 +129,6 @@ void SpatialTree::end_iteration(uint32_t iteration_spp, const GuidingSettings& s
   }
   for (Leaf& l : leaves_) {
     const size_t before = leaf_bytes(l);
-    l.building.build();
     l.sampling = std::move(l.building);
     l.building = l.sampling.refined(settings.directional_threshold, settings.keep_energy);
     // A refined tree that would not fit keeps the cells it has.

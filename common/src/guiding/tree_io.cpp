@@ -14,7 +14,8 @@ namespace {
 
 constexpr char kTreeMagic[4] = {'T', 'S', 'D', 'T'};
 constexpr char kRecordsMagic[4] = {'T', 'S', 'D', 'R'};
-constexpr uint32_t kVersion = 1;
+// Version 2 added each leaf's pixel statistics and estimates; version 1 is still read (as zeros).
+constexpr uint32_t kVersion = 2;
 
 struct Writer {
   std::string& out;
@@ -34,6 +35,7 @@ struct Reader {
   std::string_view in;
   size_t pos = 0;
   bool ok = true;
+  uint32_t version = 0;
   template <class T>
   T get() {
     T v{};
@@ -63,7 +65,8 @@ struct Reader {
   bool magic(const char (&m)[4]) {
     if (in.size() < 8 || std::memcmp(in.data(), m, 4) != 0) return false;
     pos = 4;
-    return get<uint32_t>() == kVersion;
+    version = get<uint32_t>();
+    return version == 1 || version == kVersion;
   }
   size_t left() const { return in.size() - pos; }
 };
@@ -89,8 +92,8 @@ struct TreeIo {
         if (c = r.get<uint32_t>(); c != 0 && (c <= i || c >= count)) return false;
       for (uint64_t& s : n.sum) s = r.get<uint64_t>();
     }
-    t.set_densities();
-    return r.ok;
+    t.set_cells();
+    return r.ok && t.depth() <= DirectionalTree::kMaxDepth;  // (as refined() makes them)
   }
   static void write(Writer& w, const BsdfFractionLoss& l) {
     for (int64_t v : l.loss_) w.put(v);
@@ -116,7 +119,11 @@ struct TreeIo {
     w.put(uint32_t(t.leaves_.size()));
     for (const SpatialTree::Leaf& l : t.leaves_) {
       w.put(l.samples);
+      w.put(l.pixel_sum);
+      w.put(l.pixel_paths);
       w.put(l.bsdf_fraction);
+      w.put(l.radiance);
+      w.put(l.pixel);
       write(w, l.fraction_loss);
       write(w, l.sampling);
       write(w, l.building);
@@ -156,9 +163,13 @@ struct TreeIo {
     for (uint32_t i = 0; ok && i < leaves; ++i) {
       SpatialTree::Leaf& l = out.leaves_[i];
       l.samples = r.get<uint64_t>();
+      if (r.version > 1) l.pixel_sum = r.get<uint64_t>(), l.pixel_paths = r.get<uint64_t>();
       l.bsdf_fraction = r.get<float>();
+      if (r.version > 1) l.radiance = r.get<float>(), l.pixel = r.get<float>();
       read(r, l.fraction_loss);
-      ok = l.bsdf_fraction >= 0.f && l.bsdf_fraction <= 1.f && read(r, l.sampling) && read(r, l.building);
+      // (Estimates are finite and not negative: roulette divides by them.)
+      ok = l.bsdf_fraction >= 0.f && l.bsdf_fraction <= 1.f && l.radiance >= 0.f && l.pixel >= 0.f &&
+           std::isfinite(l.radiance) && std::isfinite(l.pixel) && read(r, l.sampling) && read(r, l.building);
     }
     for (const SpatialTree::Node& n : out.nodes_) ok = ok && (n.leaf == SpatialTree::kNoLeaf || n.leaf < leaves);
     if (!ok || !r.ok || r.left() != 0) {
@@ -209,6 +220,15 @@ struct TreeIo {
       for (int64_t v : t.leaves_[lossy[k]].fraction_loss.loss_) w.signed_varint(v);
       w.varint(t.leaves_[lossy[k]].fraction_loss.records_);
     }
+    std::vector<uint32_t> pixels;
+    for (uint32_t i = 0; i < t.leaves_.size(); ++i)
+      if (t.leaves_[i].pixel_paths) pixels.push_back(i);
+    w.varint(pixels.size());
+    for (size_t k = 0; k < pixels.size(); ++k) {
+      w.varint(pixels[k] - (k ? pixels[k - 1] : 0));
+      w.varint(t.leaves_[pixels[k]].pixel_paths);
+      w.varint(t.leaves_[pixels[k]].pixel_sum);
+    }
     std::vector<std::pair<uint64_t, uint64_t>> sums;
     for (uint32_t i = 0; i < t.leaves_.size(); ++i) {
       const std::vector<DirectionalTree::Node>& nodes = t.leaves_[i].building.nodes_;
@@ -227,6 +247,11 @@ struct TreeIo {
   struct Records {
     std::vector<std::pair<uint32_t, uint64_t>> samples;
     std::vector<std::pair<uint32_t, BsdfFractionLoss>> losses;
+    struct Pixel {
+      uint32_t leaf;
+      uint64_t paths, sum;
+    };
+    std::vector<Pixel> pixels;
     struct Sum {
       uint32_t leaf;
       uint64_t cell;  // node * 4 + quadrant in the leaf's building tree
@@ -260,6 +285,11 @@ bool TreeIo::parse_records(const SpatialTree& t, std::string_view bytes, Records
     l.records_ = r.varint();
     out.losses.emplace_back(uint32_t(leaf), l);
   });
+  if (r.version > 1)
+    read_list(t.leaves_.size(), [&](uint64_t leaf) {
+      const uint64_t paths = r.varint();
+      out.pixels.push_back({uint32_t(leaf), paths, r.varint()});
+    });
   read_list(offset.back(), [&](uint64_t at) {
     // Only leaf quadrants hold recorded sums (inner ones are made by build()).
     const size_t leaf = size_t(std::upper_bound(offset.begin(), offset.end(), at) - offset.begin()) - 1;
@@ -279,6 +309,10 @@ bool TreeIo::add_records(SpatialTree& t, std::string_view bytes, std::string& er
   if (!parse_records(t, bytes, records, error)) return false;  // (the tree unchanged)
   for (auto& [leaf, n] : records.samples) t.leaves_[leaf].samples += n;
   for (auto& [leaf, l] : records.losses) t.leaves_[leaf].fraction_loss.merge(l);
+  for (const Records::Pixel& p : records.pixels) {
+    t.leaves_[p.leaf].pixel_paths += p.paths;
+    t.leaves_[p.leaf].pixel_sum += p.sum;
+  }
   for (const Records::Sum& s : records.sums)  // (wraps as record()'s atomic add does)
     t.leaves_[s.leaf].building.nodes_[s.cell / 4].sum[s.cell % 4] += s.value;
   return true;

@@ -26,6 +26,7 @@ float guided_pdf(const Bsdf& bsdf, const SurfaceInteraction& si, Vec3 wo, Vec3 w
 bool sample_guided(const Bsdf& bsdf, const SurfaceInteraction& si, Vec3 wo, const DirectionalTree& guide,
                    float bsdf_fraction, float u_lobe, Vec2 u_dir, BsdfSample& out, MixturePdfs* parts) {
   Vec2 square;
+  MixturePdfs pdfs;
   if (u_lobe < bsdf_fraction) {
     // (u_lobe / bsdf_fraction is uniform in [0,1) again: the BSDF's own lobe choice.)
     const float u = std::min(u_lobe / bsdf_fraction, 1.f - 0x1p-24f);
@@ -36,15 +37,17 @@ bool sample_guided(const Bsdf& bsdf, const SurfaceInteraction& si, Vec3 wo, cons
       return true;
     }
     square = direction_to_square(si.to_world(out.wi));
+    pdfs = mixture_pdfs(bsdf, si, wo, out.wi, square, guide);
   } else {
-    // The guide's density at the point it drew, not at the direction mapped back (which differs
-    // only where rounding crosses a cell's edge, and would cost an arc tangent).
-    float guide_pdf = 0.f;
-    out.wi = si.to_local(guide.sample(u_dir, guide_pdf, &square));
+    // The guide's density at the point it drew (pdf_at() there, without its descent), not at the
+    // direction mapped back (which differs only where rounding crosses a cell's edge, and would
+    // cost an arc tangent).
+    out.wi = si.to_local(guide.sample(u_dir, pdfs.guide, &square));
     out.eta = 1.f;
     out.delta = false;
+    pdfs.bsdf = bsdf.pdf(si, wo, out.wi);
+    pdfs.square = square;
   }
-  const MixturePdfs pdfs = mixture_pdfs(bsdf, si, wo, out.wi, square, guide);
   if (parts) *parts = pdfs;
   out.pdf = mix(pdfs, bsdf_fraction);
   if (!(out.pdf > 0.f)) return false;

@@ -7,6 +7,8 @@
 namespace tessera {
 
 void GuideRecords::commit(SpatialTree& tree, const Rgb& radiance, Sampler& sampler) const {
+  if (count_ > 0)
+    tree.record_pixel(vertices_[0].leaf, radiance.luminance(), sampler.sample_1d_at(kPixelDitherDimension));
   for (int k = 0; k < count_; ++k) {
     const Vertex& v = vertices_[size_t(k)];
     const float through = v.throughput.luminance();

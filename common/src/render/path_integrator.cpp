@@ -25,6 +25,12 @@ namespace {
 // between coincident null surfaces would otherwise never advance).
 constexpr int kMaxNullCrossings = 256;
 
+// GuideRoulette::Radiance: a path whose expected contribution is a tenth of its pixel's survives;
+// below, in proportion, but at least with 0.2 (a survivor's weight stays at most 5 where the
+// guide's estimate was wrong: lower floors made fireflies on living-room).
+constexpr float kRadianceWindow = 0.1f;
+constexpr float kMinRadianceSurvival = 0.2f;
+
 // Where next-event estimation happens: a surface (bsdf set) or a point in a medium (phase set).
 struct Vertex {
   const SurfaceInteraction* si = nullptr;
@@ -51,6 +57,8 @@ struct PathState {
   const Medium* medium = nullptr;
   const PathGuide* guide = nullptr;  // path guiding, if this pass guides or trains
   GuideRecords* records = nullptr;   // where a training pass keeps the path's vertices
+  float pixel = -1.f;                // the guide's estimate of the pixel (at the first guided vertex)
+  float radiance = 0.f;              // its estimate of the radiance along the last guided direction
   SampleFeatures* features = nullptr;  // AOVs, when asked for (aov.h)
   Vec3 camera_o;                       // the camera ray's origin, for the depth AOV
 };
@@ -210,11 +218,8 @@ class PathIntegrator final : public Integrator {
     path.prev_ctx = {si.p, si.shading.n};
     ++path.depth;
     if (media) path.medium = medium_after(si, wi_world, path.medium);
-    // (Müller's rule, asked for: once the guide samples, guided and delta vertices keep their paths.)
-    const bool keep = path.guide && path.guide->sample && path.guide->guided_roulette;
-    if (!(keep ? survives_guided_roulette(path.depth, u.u_rr, path.throughput)
-               : survives_roulette(path.depth, path.throughput, path.eta, u.u_rr)))
-      return false;
+    if (guide && !bs.delta && path.pixel < 0.f) path.pixel = path.guide->tree->pixel(leaf);
+    if (!survives_vertex(path, leaf, bs.delta, guide ? &mixture : nullptr, u.u_rr)) return false;
     path.ray = spawn_ray(si, wi_world);
     ++counters.bounce_rays;
     return true;
@@ -249,6 +254,35 @@ class PathIntegrator final : public Integrator {
     return !throughput.is_black();
   }
 
+  // Russian roulette after a surface vertex: as the guide's settings ask once it samples, else
+  // by the throughput.
+  bool survives_vertex(PathState& path, uint32_t leaf, bool delta, const MixturePdfs* mixture, float u_rr) const {
+    if (path.guide && path.guide->sample) {
+      if (path.guide->roulette == GuideRoulette::Guided) return survives_guided_roulette(path.depth, u_rr, path.throughput);
+      if (path.guide->roulette == GuideRoulette::Radiance) {
+        if (const float q = radiance_survival(path, leaf, delta, mixture); q > 0.f) {
+          if (!(u_rr < q)) return false;
+          path.throughput *= 1.f / q;
+          return !path.throughput.is_black();
+        }
+      }
+    }
+    return survives_roulette(path.depth, path.throughput, path.eta, u_rr);
+  }
+
+  // GuideRoulette::Radiance's survival probability: the path's expected contribution from wi (its
+  // throughput times the guide's radiance estimate along wi) over the pixel's estimate, relative to
+  // kRadianceWindow, within [kMinRadianceSurvival, 0.99] (so that paths in glass end too); 0 where
+  // the guide knows neither. A delta vertex takes the estimate of the last guided one: what lies
+  // along its chain.
+  static float radiance_survival(PathState& path, uint32_t leaf, bool delta, const MixturePdfs* mixture) {
+    if (!(path.pixel > 0.f)) return 0.f;
+    if (!delta) path.radiance = mixture ? path.guide->tree->radiance(leaf) * mixture->guide : 0.f;
+    if (!(path.radiance > 0.f)) return 0.f;
+    const float q = path.throughput.luminance() * path.radiance / (path.pixel * kRadianceWindow);
+    return std::clamp(q, kMinRadianceSurvival, 0.99f);
+  }
+
   // Müller et al.'s guided roulette (their code): survival 0.99 whatever the throughput, which a
   // guided direction toward bright light makes small.
   bool survives_guided_roulette(int depth, float u_rr, Rgb& throughput) const {
@@ -272,6 +306,13 @@ class PathIntegrator final : public Integrator {
     return power_heuristic(prev_pdf, light_pdf());
   }
 
+  // The density with which the vertex would have sampled the world direction `wi`.
+  static float vertex_pdf(const Vertex& v, Vec3 wi_world) {
+    if (!v.si) return v.phase->pdf(v.wo, wi_world);
+    const Vec3 wi = v.si->to_local(wi_world);
+    return v.guide ? guided_pdf(*v.bsdf, *v.si, v.wo, wi, *v.guide, v.bsdf_fraction) : v.bsdf->pdf(*v.si, v.wo, wi);
+  }
+
   // One light sample, weighted by the strategy (MIS: against the BSDF or phase function); not yet
   // multiplied by the throughput.
   Rgb sample_direct(const Scene& scene, const Vertex& v, float u_pick, Vec2 u_light, RenderCounters& counters) const {
@@ -288,18 +329,14 @@ class PathIntegrator final : public Integrator {
     if (!(ls.pdf > 0.f) || (!ls.li_deferred && ls.li.is_black())) return {};
     if (bsdf_only && !ls.delta) return {};
     Rgb f;
-    float scatter_pdf = 0.f;
     const Medium* shadow_medium = v.medium;
     if (v.si) {
       const Vec3 wi = v.si->to_local(ls.wi);
       if (!consistent_side(*v.si, ls.wi, wi)) return {};
       f = v.bsdf->eval(*v.si, v.wo, wi);
-      if (!ls.delta && mis)
-        scatter_pdf = v.guide ? guided_pdf(*v.bsdf, *v.si, v.wo, wi, *v.guide, v.bsdf_fraction) : v.bsdf->pdf(*v.si, v.wo, wi);
       if (volumetric_) shadow_medium = medium_after(*v.si, ls.wi, v.medium);
     } else {
       f = Rgb(v.phase->eval(v.wo, ls.wi));
-      if (!ls.delta && mis) scatter_pdf = v.phase->pdf(v.wo, ls.wi);
     }
     if (f.is_black()) return {};
     const Vec3 p_error = v.si ? v.si->p_error : Vec3(0.f);  // a medium vertex is exact
@@ -309,6 +346,9 @@ class PathIntegrator final : public Integrator {
     ++counters.shadow_rays;
     const Rgb tr = volumetric_ ? scene.transmittance(shadow, shadow_medium) : Rgb(scene.transmittance(shadow));
     if (tr.is_black()) return {};
+    // (After the shadow ray: most light samples of a room lit through an opening are occluded, and
+    // a guided vertex's mixture pdf is a descent of its guide.)
+    const float scatter_pdf = !ls.delta && mis ? vertex_pdf(v, ls.wi) : 0.f;
     const Rgb li = ls.li_deferred ? light->deferred_li(ls) : ls.li;
     float light_pdf = ls.pdf * pmf;
     float w = ls.delta || !mis ? 1.f : power_heuristic(light_pdf, scatter_pdf);

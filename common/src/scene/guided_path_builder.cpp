@@ -96,6 +96,9 @@ void read_guided_path(BuildState& st, const SceneNode& node) {
   read_combination(st, node, g);
   read_filters_and_loss(st, node, g);
   read_notes(st, node);
+  // (Tessera's own: Müller's plugin always keeps paths with probability 0.99, "guided".)
+  (void)parse_guide_roulette(choice(node, "roulette", guide_roulette_name(g.roulette), {"radiance", "throughput", "guided"}),
+                             g.roulette);
   g.bsdf_fraction = float(number_in(node, name_in(node, "bsdf_sampling_fraction", "bsdfSamplingFraction"), 0.5, 0, 1, true));
   g.spatial_threshold = number_in(node, name_in(node, "s_tree_threshold", "sTreeThreshold"), 12000, 0, 1e9, true);
   g.directional_threshold = number_in(node, name_in(node, "d_tree_threshold", "dTreeThreshold"), 0.01, 0, 1, true);

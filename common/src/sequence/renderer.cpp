@@ -36,7 +36,7 @@ class PathUnits final : public UnitRenderer {
     if (work.uses) {
       const auto& tree = static_cast<const GuideArtifact*>(sequencer.artifact(*work.uses))->tree();
       guide = PathGuide{&tree, work.feeds ? &guide_->recorder() : nullptr, *work.uses > 0, work.feeds.has_value(),
-                        guide_->settings().roulette == GuideRoulette::Guided};
+                        guide_->settings().roulette};
     }
     const PassSamples samples = work.samples ? *work.samples : PassSamples::uniform(work.rect, work.sample_begin, work.sample_end);
     render_tile(scene_, *integrator_, work.rect, samples, seed_, result.tile, guide ? &*guide : nullptr, aovs_);

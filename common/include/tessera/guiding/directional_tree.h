@@ -38,6 +38,11 @@ class DirectionalTree {
   /// A larger record is clamped to this (keeps sums of millions of records within 64 bits).
   static constexpr float kMaxRecord = float(1 << 24);
 
+  /// `value` (clamped to [0, kMaxRecord]) in fixed point, rounded up with probability equal to
+  /// its fraction, decided by `dither` in [0,1); 0 for NaN.
+  static uint64_t fixed_point(float value, float dither);
+  static double from_fixed_point(double sum) { return sum * (1.0 / double(uint64_t(1) << kScaleBits)); }
+
   /// One node: the whole sphere in four leaf quadrants.
   DirectionalTree();
 
@@ -72,7 +77,7 @@ class DirectionalTree {
   /// All energy recorded (after build()), in fixed-point units.
   uint64_t total() const;
   size_t node_count() const { return nodes_.size(); }
-  size_t bytes() const { return sizeof(*this) + nodes_.size() * sizeof(Node) + density_.size() * sizeof(density_[0]); }
+  size_t bytes() const { return sizeof(*this) + nodes_.size() * (sizeof(Node) + sizeof(Cell)); }
   int depth() const;
   /// The sums and structure compare equal.
   bool operator==(const DirectionalTree& other) const;
@@ -83,18 +88,22 @@ class DirectionalTree {
     std::array<uint64_t, 4> sum{};
   };
   // Quadrant i covers x in [i&1 ? 0.5 : 0, ...) and y in [i&2 ? 0.5 : 0, ...) of its node.
-  static int quadrant(Vec2& p);
+  // What sampling and densities read, half a cache line per node: each quadrant's factor of the
+  // density on the square, 4 x its share of the node's energy (1 in a node without energy), and
+  // the children again. pdf_at() multiplies the factors along its descent instead of dividing sums.
+  struct alignas(32) Cell {
+    std::array<float, 4> density{1.f, 1.f, 1.f, 1.f};
+    std::array<uint32_t, 4> child{};
+  };
   uint64_t build_node(uint32_t n);
-  void set_densities();
+  void set_cells();
   friend struct TreeIo;  // tree_io.h
   void refine_into(DirectionalTree& out, uint32_t out_node, const Node* node, double scale, uint64_t energy,
                    int depth, double threshold, bool keep_sums) const;
 
   std::vector<Node> nodes_;
-  // Per node, each quadrant's factor of the density on the square, 4 x its share of the node's
-  // energy (1 in a node without energy): pdf_at() multiplies them along its descent instead of
-  // dividing sums. Made by build() and when a tree is read; a tree that samples has them.
-  std::vector<std::array<float, 4>> density_;
+  // A Cell per node, made by build() and when a tree is refined or read: every tree holds them.
+  std::vector<Cell> cells_;
 };
 
 }  // namespace tessera

@@ -15,6 +15,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace tessera {
@@ -32,15 +33,21 @@ const char* guide_combination_name(GuideCombination c);
 
 /// Russian roulette on a guided render's paths.
 enum class GuideRoulette : uint8_t {
-  /// From the throughput, as unguided paths (path_integrator: Mitsuba 3's rule). The default:
-  /// Müller's rule made every path in a closed interior run to its maximum depth.
+  /// From the throughput, as unguided paths (path_integrator: Mitsuba 3's rule). It ends the paths
+  /// a guide sends toward bright light through a small opening (their f·cos/p is small).
   Throughput,
   /// Müller's code: once the guide samples, a path survives a vertex with probability 0.99 whatever
-  /// its throughput (a guided direction toward bright light has a small f·cos/p, which a throughput
-  /// rule would end).
+  /// its throughput. Every path in a closed interior then runs to its maximum depth.
   Guided,
+  /// Adjoint-driven (after Vorba and Křivánek 2016, without splitting; the default): a path
+  /// survives a vertex with probability T·L̂(wi) / (0.1·Î) within [0.2, 0.99], its expected
+  /// contribution over a tenth of the pixel's, from the guide's estimates (SpatialTree::radiance,
+  /// pixel); by its throughput where the guide has none.
+  Radiance,
 };
 const char* guide_roulette_name(GuideRoulette r);
+/// False when `name` is none of guide_roulette_name()'s.
+[[nodiscard]] bool parse_guide_roulette(const std::string& name, GuideRoulette& out);
 
 struct GuidingSettings {
   /// c of the spatial split rule: a leaf is split at the end of an iteration of spp_k samples per
@@ -64,7 +71,7 @@ struct GuidingSettings {
   GuideCombination combination = GuideCombination::InverseVariance;
   /// (InverseVariance) How many of the last iterations the image combines (Müller: 4).
   int combined_iterations = 4;
-  GuideRoulette roulette = GuideRoulette::Throughput;
+  GuideRoulette roulette = GuideRoulette::Radiance;
 };
 
 /// The samples a leaf must exceed in an iteration of `iteration_spp` samples per pixel to be split:
@@ -88,6 +95,14 @@ class SpatialTree {
   }
   /// The same at the direction's point on the square (DirectionalTree::record_at).
   void record_at(uint32_t leaf, Vec2 square, float value, float dither);
+  /// Records the luminance of a path's estimate (a pixel sample) whose first recorded vertex is in
+  /// the leaf. Thread-safe against other record calls.
+  void record_pixel(uint32_t leaf, float value, float dither);
+  /// The previous iteration's estimates at the leaf: the incident luminance integrated over the
+  /// sphere (the radiance from wi is that times sampling(leaf).pdf(wi)), and the mean pixel sample
+  /// of the paths that began there (record_pixel). 0 where nothing was recorded.
+  float radiance(uint32_t leaf) const { return leaves_[leaf].radiance; }
+  float pixel(uint32_t leaf) const { return leaves_[leaf].pixel; }
   /// The leaf's probability of sampling the BSDF rather than its guide.
   float bsdf_fraction(uint32_t leaf) const { return leaves_[leaf].bsdf_fraction; }
   /// Records a guided sample's share of the loss that chooses that probability (BsdfFractionLoss).
@@ -117,8 +132,10 @@ class SpatialTree {
   struct Leaf {
     DirectionalTree sampling, building;
     uint64_t samples = 0;
+    uint64_t pixel_sum = 0, pixel_paths = 0;  // record_pixel's, fixed point as DirectionalTree's
     BsdfFractionLoss fraction_loss;
     float bsdf_fraction = 0.5f;
+    float radiance = 0.f, pixel = 0.f;
     bool operator==(const Leaf&) const = default;
   };
   void split(uint32_t node);

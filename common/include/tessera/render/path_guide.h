@@ -30,9 +30,8 @@ struct PathGuide {
   SpatialTree* records = nullptr;     // where training records go: `tree`, or a recorder of it (tree_io.h)
   bool sample = false;                // guide directions with the tree's learned distributions
   bool train = false;                 // record the pass's radiance into `records`
-  /// Once the guide samples, paths survive Russian roulette with probability 0.99
-  /// (GuideRoulette::Guided, Müller's) rather than by their throughput.
-  bool guided_roulette = false;
+  /// Russian roulette once the guide samples (before, by throughput).
+  GuideRoulette roulette = GuideRoulette::Throughput;
 };
 
 /// The vertices of one path that sampled a direction to record, and at the path's end the
@@ -42,6 +41,8 @@ class GuideRecords {
   static constexpr int kCapacity = 32;
   /// Dimensions of the dither of vertex k: kDitherDimension + k (far from the sequential ones).
   static constexpr uint32_t kDitherDimension = 0xFFFFFE00u;
+  /// The dither of the pixel sample.
+  static constexpr uint32_t kPixelDitherDimension = kDitherDimension + kCapacity;
 
   /// A vertex in `leaf` sampled `wi` (world) with density `pdf`, where the BSDF's f * cos has
   /// luminance `f_cos`; `throughput` is the path's after the vertex's weight (before Russian
@@ -54,7 +55,8 @@ class GuideRecords {
     const Vec2 square = mixture ? mixture->square : direction_to_square(wi);
     vertices_[size_t(count_++)] = {leaf, square, pdf, f_cos, mixture, throughput, radiance};
   }
-  /// Records every vertex into `tree` once the path's estimate is `radiance`.
+  /// Records every vertex into `tree` once the path's estimate is `radiance`, and that estimate as
+  /// a pixel sample at the first vertex's leaf.
   void commit(SpatialTree& tree, const Rgb& radiance, Sampler& sampler) const;
 
  private:
