@@ -246,8 +246,13 @@ class PathIntegrator final : public Integrator {
   // Russian roulette as Mitsuba 3: survival probability from the throughput, times eta^2 so that
   // refraction's radiance scaling does not kill paths inside glass early; capped at 0.95.
   bool survives_roulette(int depth, Rgb& throughput, float eta, float u_rr) const {
-    if (depth >= s_.rr_depth) {
-      float q = std::min(throughput.max_value() * eta * eta, 0.95f);
+    return survives(depth >= s_.rr_depth ? std::min(throughput.max_value() * eta * eta, 0.95f) : 1.f, u_rr, throughput);
+  }
+
+  // The path survives with probability q (1: no roulette), its throughput divided by q; a path
+  // that carries nothing ends.
+  static bool survives(float q, float u_rr, Rgb& throughput) {
+    if (q < 1.f) {
       if (!(u_rr < q)) return false;
       throughput *= 1.f / q;
     }
@@ -258,14 +263,12 @@ class PathIntegrator final : public Integrator {
   // by the throughput.
   bool survives_vertex(PathState& path, uint32_t leaf, bool delta, const MixturePdfs* mixture, float u_rr) const {
     if (path.guide && path.guide->sample) {
-      if (path.guide->roulette == GuideRoulette::Guided) return survives_guided_roulette(path.depth, u_rr, path.throughput);
-      if (path.guide->roulette == GuideRoulette::Radiance) {
-        if (const float q = radiance_survival(path, leaf, delta, mixture); q > 0.f) {
-          if (!(u_rr < q)) return false;
-          path.throughput *= 1.f / q;
-          return !path.throughput.is_black();
-        }
-      }
+      // (Müller's rule: 0.99 whatever the throughput, which a guided direction toward bright light
+      // makes small.)
+      if (path.guide->roulette == GuideRoulette::Guided)
+        return survives(path.depth >= s_.rr_depth ? 0.99f : 1.f, u_rr, path.throughput);
+      if (path.guide->roulette == GuideRoulette::Radiance)
+        if (const float q = radiance_survival(path, leaf, delta, mixture); q > 0.f) return survives(q, u_rr, path.throughput);
     }
     return survives_roulette(path.depth, path.throughput, path.eta, u_rr);
   }
@@ -281,17 +284,6 @@ class PathIntegrator final : public Integrator {
     if (!(path.radiance > 0.f)) return 0.f;
     const float q = path.throughput.luminance() * path.radiance / (path.pixel * kRadianceWindow);
     return std::clamp(q, kMinRadianceSurvival, 0.99f);
-  }
-
-  // Müller et al.'s guided roulette (their code): survival 0.99 whatever the throughput, which a
-  // guided direction toward bright light makes small.
-  bool survives_guided_roulette(int depth, float u_rr, Rgb& throughput) const {
-    constexpr float kSurvival = 0.99f;
-    if (depth >= s_.rr_depth) {
-      if (!(u_rr < kSurvival)) return false;
-      throughput *= 1.f / kSurvival;
-    }
-    return !throughput.is_black();
   }
 
   // Weight of an emitter found by a BSDF/phase-sampled ray after a non-delta lobe (integrator.h);
