@@ -4,7 +4,8 @@
 # unit, and the bytes a unit's result takes on the wire. Checks the images are bit-identical.
 # With ADAPTIVE=on, both render with --adaptive on, and the time the coordinator spent deciding the
 # adaptive passes' counts at their barriers is printed too. With GUIDING=on, both guide, and the
-# learned trees' bytes (as stored and sent to workers) and the time spent making them are printed.
+# learned trees' bytes (as stored and sent to workers) and the time spent making them are printed,
+# in all and per barrier.
 # Usage: bench/farm_overhead.sh [BUILD_DIR] [SPP] [SIZE] [TILE] [ADAPTIVE] [GUIDING] [SCENE]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -67,7 +68,14 @@ for workers in 1 2; do
     field() { echo "$guides" | grep -o " $1=[0-9.e+-]*" | cut -d= -f2; }
     printf "%-28s %d guides stored, %.2f MB in all (last %.2f MB, %.1f MB in memory); trees made at barriers in %.1f ms, encoded and written in %.1f ms in all\n" \
         "" "$(echo "$guides" | wc -l)" "$(field bytes | awk '{s += $1} END {print s / 1e6}')" \
-        "$(field bytes | tail -1 | awk '{print $1 / 1e6}')" "$(field tree_bytes | tail -1 | awk '{print $1 / 1e6}')" \
+        "$(field bytes | tail -1 | awk '{print $1 / 1e6}')" "$(field memory_bytes | tail -1 | awk '{print $1 / 1e6}')" \
         "$(field barrier_seconds | awk '{s += $1} END {print 1000 * s}')" "$(field seconds | awk '{s += $1} END {print 1000 * s}')"
+    # Per barrier: the iteration the tree serves, its bytes on the wire, the time the coordinator
+    # took to make it under the job's lock and then to encode and write it off the lock.
+    paste -d' ' <(field iteration) <(field bytes) <(field barrier_seconds) <(field seconds) |
+      while read -r it b made written; do
+        awk -v it="$it" -v b="$b" -v made="$made" -v w="$written" 'BEGIN {
+          printf "%-28s   iteration %2d: tree %8.3f MB, made in %6.1f ms, encoded and written in %6.1f ms\n", "", it, b / 1e6, 1000 * made, 1000 * w }'
+      done
   fi
 done

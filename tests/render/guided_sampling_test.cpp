@@ -1,12 +1,14 @@
 // Path guiding's mixture of BSDF and guided sampling (render/guided_sampling.h): its samples follow
 // its pdf (chi-square) for diffuse and rough metal BSDFs and a trained guide, its weight is
-// eval / pdf, and a delta lobe keeps the BSDF's weight for the probability of choosing the BSDF.
+// eval / pdf, a delta lobe keeps the BSDF's weight for the probability of choosing the BSDF, and
+// only lobes rough enough are guided.
 #include "tessera/render/guided_sampling.h"
 
 #include "support/chi2.h"
 #include "tessera/bsdf/conductor.h"
 #include "tessera/bsdf/dielectric.h"
 #include "tessera/bsdf/diffuse.h"
+#include "tessera/bsdf/roughplastic.h"
 #include "tessera/core/hash.h"
 #include "tessera/core/sampling.h"
 
@@ -91,6 +93,21 @@ TEST(GuidedSampling, ADeltaLobeKeepsTheBsdfWeightOverTheChoice) {
   EXPECT_EQ(guided.wi, plain.wi);
   EXPECT_FLOAT_EQ(guided.weight.g, plain.weight.g / 0.5f);
   EXPECT_FLOAT_EQ(guided.pdf, plain.pdf * 0.5f);
+}
+
+TEST(GuidedSampling, OnlyLobesRoughEnoughAreGuided) {
+  const SurfaceInteraction si;
+  const auto metal = [](float alpha) {
+    return make_roughconductor_bsdf(MicrofacetType::Ggx, constant(alpha), nullptr, *lookup_metal("Au"), constant(1.f));
+  };
+  EXPECT_TRUE(guides_lobe(*make_diffuse_bsdf(constant(0.5f)), si));
+  EXPECT_TRUE(guides_lobe(*metal(0.5f), si));
+  EXPECT_TRUE(guides_lobe(*metal(kMinGuidedRoughness), si));
+  EXPECT_FALSE(guides_lobe(*metal(0.25f), si)) << "veach-mis's roughest plate: the BSDF samples it alone";
+  EXPECT_FALSE(guides_lobe(*metal(0.01f), si));
+  EXPECT_FALSE(guides_lobe(*make_dielectric_bsdf(1.5f, constant(1.f), constant(1.f)), si));
+  // A glossy coat over a diffuse base: the base is what the guide helps.
+  EXPECT_TRUE(guides_lobe(*make_roughplastic_bsdf(MicrofacetType::Ggx, 0.05f, 1.5f, constant(0.5f), constant(1.f), false), si));
 }
 
 }  // namespace

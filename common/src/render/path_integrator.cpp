@@ -26,10 +26,11 @@ namespace {
 constexpr int kMaxNullCrossings = 256;
 
 // GuideRoulette::Radiance: a path whose expected contribution is a tenth of its pixel's survives;
-// below, in proportion, but at least with 0.2 (a survivor's weight stays at most 5 where the
-// guide's estimate was wrong: lower floors made fireflies on living-room).
+// below, in proportion, but at least with 0.35 (a survivor's weight stays under 3 where the
+// guide's estimate was wrong: lower floors made fireflies on living-room and bathroom, higher ones
+// cost living-room more time than they saved error; docs/performance.md).
 constexpr float kRadianceWindow = 0.1f;
-constexpr float kMinRadianceSurvival = 0.2f;
+constexpr float kMinRadianceSurvival = 0.35f;
 
 // Where next-event estimation happens: a surface (bsdf set) or a point in a medium (phase set).
 struct Vertex {
@@ -181,10 +182,12 @@ class PathIntegrator final : public Integrator {
     if (!bsdf) return false;
     const Vec3 wo = si.to_local(wo_world);
     const BounceSamples u = BounceSamples::draw(sampler);
-    // Guided where a direction is sampled at all (not at delta-only BSDFs).
-    const bool guided = path.guide && !bsdf->is_delta();
-    const uint32_t leaf = guided ? path.guide->tree->leaf_of(si.p) : 0;
-    const DirectionalTree* guide = guided && path.guide->sample ? &path.guide->tree->sampling(leaf) : nullptr;
+    // Recorded where a direction is sampled at all (not at delta-only BSDFs); guided where the
+    // lobe is rough enough (guides_lobe).
+    const bool recorded = path.guide && !bsdf->is_delta();
+    const uint32_t leaf = recorded ? path.guide->tree->leaf_of(si.p) : 0;
+    const bool guided = recorded && path.guide->sample && guides_lobe(*bsdf, si);
+    const DirectionalTree* guide = guided ? &path.guide->tree->sampling(leaf) : nullptr;
     const float fraction = guide ? path.guide->tree->bsdf_fraction(leaf) : 1.f;
     if (!bsdf->is_delta()) {
       Vertex v;
@@ -218,7 +221,8 @@ class PathIntegrator final : public Integrator {
     path.prev_ctx = {si.p, si.shading.n};
     ++path.depth;
     if (media) path.medium = medium_after(si, wi_world, path.medium);
-    if (guide && !bs.delta && path.pixel < 0.f) path.pixel = path.guide->tree->pixel(leaf);
+    // (The pixel's estimate is kept by the leaf of the path's first recorded vertex: SpatialTree::pixel.)
+    if (recorded && path.guide->sample && !bs.delta && path.pixel < 0.f) path.pixel = path.guide->tree->pixel(leaf);
     if (!survives_vertex(path, leaf, bs.delta, guide ? &mixture : nullptr, u.u_rr)) return false;
     path.ray = spawn_ray(si, wi_world);
     ++counters.bounce_rays;

@@ -40,7 +40,7 @@ enum class GuideRoulette : uint8_t {
   /// its throughput. Every path in a closed interior then runs to its maximum depth.
   Guided,
   /// Adjoint-driven (after Vorba and Křivánek 2016, without splitting; the default): a path
-  /// survives a vertex with probability T·L̂(wi) / (0.1·Î) within [0.2, 0.99], its expected
+  /// survives a vertex with probability T·L̂(wi) / (0.1·Î) within [0.35, 0.99], its expected
   /// contribution over a tenth of the pixel's, from the guide's estimates (SpatialTree::radiance,
   /// pixel); by its throughput where the guide has none.
   Radiance,
