@@ -126,8 +126,9 @@ TileResult render_lease(const Scene& scene, const Lease& lease, const SpatialTre
   if (lease.guide) {
     // (The job's guide settings are the scene's, as guide_plan() made them at submission.)
     const std::optional<GuidePlan> plan = guide_plan(scene, true);
-    path_guide = PathGuide{guide, recorder ? &*recorder : nullptr, lease.guide->iteration > 0, lease.guide->train,
-                           plan ? plan->settings.roulette : GuideRoulette::Throughput};
+    if (!plan) throw std::invalid_argument("render_lease: a guided lease of a scene that cannot be guided");
+    path_guide = PathGuide::of(guide, recorder ? &*recorder : nullptr, lease.guide->iteration > 0, lease.guide->train,
+                               plan->settings);
   }
   // A denoised job's units, or one's with AOV layers, also sum the AOVs.
   render_tile(scene, lease.rect, samples, lease.settings.seed, result.film, path_guide ? &*path_guide : nullptr,
@@ -244,7 +245,9 @@ json guide_json(const JobPlan::Guide& g) {
           {"keep_energy", s.keep_energy},
           {"combination", guide_combination_name(s.combination)},
           {"combined_iterations", s.combined_iterations},
-          {"roulette", guide_roulette_name(s.roulette)}};
+          {"roulette", guide_roulette_name(s.roulette)},
+          {"spatial_filter", spatial_filter_name(s.spatial_filter)},
+          {"directional_filter", directional_filter_name(s.directional_filter)}};
 }
 
 JobPlan::Guide guide_from_json(const json& j) {
@@ -268,6 +271,10 @@ JobPlan::Guide guide_from_json(const json& j) {
   if (!parse_guide_roulette(roulette, s.roulette)) throw std::invalid_argument("guide roulette");
   s.combination = combination == "discard" ? GuideCombination::Discard : GuideCombination::InverseVariance;
   s.combined_iterations = j.value("combined_iterations", 4);
+  if (!parse_spatial_filter(j.value("spatial_filter", "nearest"), s.spatial_filter))
+    throw std::invalid_argument("guide spatial_filter");
+  if (!parse_directional_filter(j.value("directional_filter", "nearest"), s.directional_filter))
+    throw std::invalid_argument("guide directional_filter");
   if (s.combined_iterations < 1) throw std::invalid_argument("guide combined_iterations");
   return g;
 }

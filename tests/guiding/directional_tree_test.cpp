@@ -69,6 +69,48 @@ TEST(DirectionalTree, SquareMapIsTheInverseOfTheSphereMap) {
   }
 }
 
+TEST(DirectionalTree, MapsTheAzimuthAsAtan2Does) {
+  // The polynomial arc tangent: within a few float roundings of double atan2 in every octant,
+  // also on the axes and diagonals where its mirroring changes.
+  Pcg32 rng(11);
+  std::vector<Vec3> dirs;
+  for (int k = 0; k < 100000; ++k) dirs.push_back(square_to_uniform_sphere(Vec2(rng.next_float(), rng.next_float())));
+  for (float x : {-1.f, -0.6f, 0.f, 0.6f, 1.f})
+    for (float y : {-1.f, -0.6f, 0.f, 0.6f, 1.f})
+      if (x != 0.f || y != 0.f) dirs.push_back(normalize(Vec3(x, y, 0.25f)));
+  double worst = 0.0;
+  for (const Vec3& d : dirs) {
+    double phi = std::atan2(double(d.y), double(d.x));
+    if (phi < 0.0) phi += 2.0 * 3.14159265358979323846;
+    const double y = direction_to_square(d).y, expected = std::min(phi / (2.0 * 3.14159265358979323846), 1.0 - 0x1p-24);
+    worst = std::max(worst, std::min(std::abs(y - expected), 1.0 - std::abs(y - expected)));  // (y wraps at 0 and 1)
+  }
+  EXPECT_LT(worst, 2e-7);
+}
+
+TEST(DirectionalTree, TheBoxFilterSharesARecordByTheAreaItCovers) {
+  // Cells of side 1/4: every root quadrant (a quarter of the energy, above 0.2) is split once.
+  DirectionalTree uniform;
+  for (int i = 0; i < 4; ++i) uniform.record_at(Vec2(0.25f + 0.5f * float(i & 1), 0.25f + 0.5f * float(i >> 1)), 1.f, 0.f);
+  uniform.build();
+  DirectionalTree tree = uniform.refined(0.2);
+  ASSERT_EQ(tree.node_count(), 5u);
+  // A box of side 1/4 about (0.3, 0.3) covers [0.175, 0.425)^2: 0.075 and 0.175 of the cells on
+  // either side of 0.25 along each axis.
+  tree.record_box(Vec2(0.3f, 0.3f), 16.f, 0.5f);
+  tree.build();
+  EXPECT_NEAR(DirectionalTree::from_fixed_point(double(tree.total())), 16.0, 1e-4);
+  const double lo = 0.075, hi = 0.175;
+  EXPECT_NEAR(tree.pdf_at(Vec2(0.1f, 0.1f)) / tree.pdf_at(Vec2(0.4f, 0.4f)), lo * lo / (hi * hi), 1e-4);
+  EXPECT_NEAR(tree.pdf_at(Vec2(0.4f, 0.1f)) / tree.pdf_at(Vec2(0.4f, 0.4f)), lo / hi, 1e-4);
+  EXPECT_EQ(tree.pdf_at(Vec2(0.6f, 0.3f)), 0.f);
+  // Beside the square's edge the part outside is dropped (as Müller's code does).
+  DirectionalTree edge = uniform.refined(0.2);
+  edge.record_box(Vec2(0.05f, 0.6f), 16.f, 0.5f);
+  edge.build();
+  EXPECT_NEAR(DirectionalTree::from_fixed_point(double(edge.total())), 16.0 * (0.05 + 0.125) / 0.25, 1e-4);
+}
+
 TEST(DirectionalTree, AnEmptyTreeIsUniform) {
   DirectionalTree tree;
   tree.build();

@@ -3,6 +3,9 @@
 // (also outside the bounds, or NaN) finds a leaf.
 #include "tessera/guiding/spatial_tree.h"
 
+#include "tessera/render/path_guide.h"
+#include "tessera/render/sampler.h"
+
 #include "tessera/core/hash.h"
 #include "tessera/core/sampling.h"
 
@@ -64,6 +67,63 @@ TEST(SpatialTree, PointsFindTheLeafOfTheirRegion) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   EXPECT_LT(tree.leaf_of(Vec3(nan, 0.f, 0.f)), tree.leaf_count());
   EXPECT_LT(tree.leaf_of(Vec3(std::numeric_limits<float>::infinity())), tree.leaf_count());
+}
+
+TEST(SpatialTree, LeavesKnowTheSizeOfTheirRegion) {
+  GuidingSettings s;
+  s.spatial_threshold = 100;
+  SpatialTree tree(unit_box());
+  record_at(tree, Vec3(0.05f), 2000, 2);
+  record_at(tree, Vec3(0.8f, 0.3f, 0.6f), 700, 3);
+  tree.end_iteration(4, s);
+  ASSERT_GT(tree.leaf_count(), 8u);
+  Pcg32 rng(4);
+  for (int k = 0; k < 200; ++k) {
+    const Vec3 p(rng.next_float(), rng.next_float(), rng.next_float());
+    Vec3 e;
+    const uint32_t leaf = tree.leaf_of(p, &e);
+    // The region is the cell of a grid of that size: its inside is the leaf, just past it is not.
+    const Vec3 lo(std::floor(p.x / e.x) * e.x, std::floor(p.y / e.y) * e.y, std::floor(p.z / e.z) * e.z);
+    EXPECT_EQ(tree.leaf_of(lo + e * 0.01f), leaf);
+    EXPECT_EQ(tree.leaf_of(lo + e * 0.99f), leaf);
+    for (int axis = 0; axis < 3; ++axis) {
+      Vec3 past = lo + e * 0.5f;
+      (&past.x)[axis] = (&lo.x)[axis] + 1.01f * (&e.x)[axis];
+      if ((&past.x)[axis] < 1.f) EXPECT_NE(tree.leaf_of(past), leaf) << "axis " << axis;
+    }
+  }
+}
+
+TEST(SpatialTree, TheStochasticFilterRecordsIntoTheNeighboursOfALeaf) {
+  GuidingSettings s;
+  s.spatial_threshold = 400;
+  SpatialTree tree(unit_box());
+  record_at(tree, Vec3(0.1f), 1000, 1);
+  tree.end_iteration(16, s);  // two leaves: x below and above 0.5
+  ASSERT_EQ(tree.leaf_count(), 2u);
+  const Vec3 p(0.45f, 0.5f, 0.5f);
+  Vec3 extent;
+  const uint32_t leaf = tree.leaf_of(p, &extent), other = tree.leaf_of(Vec3(0.9f, 0.5f, 0.5f));
+  // A vertex 0.05 from the cut, in a leaf 0.5 wide: its box reaches 0.2 past the cut, 40% of it.
+  const auto radiance_after = [&](SpatialFilter filter) {
+    SpatialTree records = tree;
+    const PathGuide guide{&tree, &records, false, true, GuideRoulette::Throughput, filter, DirectionalFilter::Nearest};
+    Sampler sampler(SamplerType::Sobol, 1);
+    for (uint32_t i = 0; i < 1000; ++i) {
+      sampler.start_pixel_sample(Vec2i(3, 4), i);
+      GuideRecords r;
+      r.add(p, extent, leaf, Vec3(0.f, 0.f, 1.f), 1.f, 1.f, std::nullopt, Rgb(1.f), Rgb(0.f));
+      r.commit(guide, Rgb(1.f), sampler);
+    }
+    records.end_iteration(16, s);
+    return std::pair(records.radiance(leaf), records.radiance(other));
+  };
+  const auto nearest = radiance_after(SpatialFilter::Nearest);
+  EXPECT_GT(nearest.first, 0.f);
+  EXPECT_EQ(nearest.second, 0.f);
+  const auto stochastic = radiance_after(SpatialFilter::Stochastic);
+  EXPECT_GT(stochastic.first, 0.f);
+  EXPECT_GT(stochastic.second, 0.f);
 }
 
 TEST(SpatialTree, TheSameRecordsInAnyOrderGiveTheSameTree) {

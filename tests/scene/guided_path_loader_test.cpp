@@ -44,6 +44,8 @@ TEST(GuidedPathLoader, MapsThePluginsParameters) {
 <integer name="sdTreeMaxMemory" value="64"/>
 <string name="nee" value="always"/>
 <string name="roulette" value="guided"/>
+<string name="spatialFilter" value="stochastic"/>
+<string name="directionalFilter" value="box"/>
 <integer name="maxDepth" value="5"/>
 )");
   const IntegratorSettings& s = r.scene->integrator;
@@ -53,6 +55,8 @@ TEST(GuidedPathLoader, MapsThePluginsParameters) {
   EXPECT_TRUE(s.guiding->learn_bsdf_fraction);
   EXPECT_EQ(s.guiding->combination, GuideCombination::Discard);
   EXPECT_EQ(s.guiding->roulette, GuideRoulette::Guided);
+  EXPECT_EQ(s.guiding->spatial_filter, SpatialFilter::Stochastic);
+  EXPECT_EQ(s.guiding->directional_filter, DirectionalFilter::Box);
   EXPECT_FLOAT_EQ(s.guiding->bsdf_fraction, 0.4f);
   EXPECT_DOUBLE_EQ(s.guiding->spatial_threshold, 4000);
   EXPECT_NEAR(s.guiding->directional_threshold, 0.02, 1e-7);
@@ -67,6 +71,10 @@ TEST(GuidedPathLoader, ThePluginsDefaultsAndItsNotes) {
   EXPECT_FALSE(r.scene->integrator.guiding->learn_bsdf_fraction);  // bsdfSamplingFractionLoss "none"
   EXPECT_FLOAT_EQ(r.scene->integrator.guiding->bsdf_fraction, 0.5f);
   EXPECT_EQ(r.scene->integrator.guiding->max_bytes, size_t(256) << 20);
+  // The plugin's own, not Tessera's defaults (GuidingSettings).
+  EXPECT_DOUBLE_EQ(r.scene->integrator.guiding->spatial_threshold, 12000);
+  EXPECT_EQ(r.scene->integrator.guiding->spatial_filter, SpatialFilter::Nearest);
+  EXPECT_EQ(r.scene->integrator.guiding->directional_filter, DirectionalFilter::Nearest);
   std::string notes;
   for (const auto& m : r.messages) notes += m.text + "\n";
   EXPECT_NE(notes.find("sampleCombination"), std::string::npos) << notes;
@@ -103,7 +111,6 @@ TEST(GuidedPathLoader, OutOfRangeValuesNameTheLineAndParameter) {
 
 TEST(GuidedPathLoader, UnimplementedOptionsAreUnsupported) {
   for (const std::string& param : {std::string("<string name=\"spatialFilter\" value=\"box\"/>\n"),
-                                   std::string("<string name=\"directionalFilter\" value=\"box\"/>\n"),
                                    std::string("<string name=\"sampleCombination\" value=\"automatic\"/>\n"),
                                    std::string("<string name=\"bsdfSamplingFractionLoss\" value=\"var\"/>\n")}) {
     EXPECT_THROW((void)load(kSpp + param), UnsupportedError) << param;

@@ -17,6 +17,7 @@ SpatialTree::SpatialTree(const Bounds3& bounds, float bsdf_fraction) : nodes_(1)
   bounds_.lo = c - Vec3(half);
   bounds_.hi = c + Vec3(half);
   nodes_[0].leaf = 0;
+  index_nodes();
 }
 
 namespace {
@@ -30,23 +31,51 @@ uint64_t cube_bits(float x) {
 
 }  // namespace
 
-uint32_t SpatialTree::leaf_of(Vec3 p) const {
+uint32_t SpatialTree::leaf_of(Vec3 p, Vec3* extent) const {
   const Vec3 size = bounds_.diagonal();
   const uint64_t bits[3] = {cube_bits((p.x - bounds_.lo.x) / size.x), cube_bits((p.y - bounds_.lo.y) / size.y),
                             cube_bits((p.z - bounds_.lo.z) / size.z)};
-  uint32_t n = 0;
-  for (uint32_t axis = 0, cut = 0; nodes_[n].leaf == kNoLeaf;) {
-    const bool upper = cut < 64 && ((bits[axis] >> (63 - cut)) & 1u);
-    n = nodes_[n].child[upper ? 1 : 0];
-    if (++axis == 3) axis = 0, ++cut;
+  const auto upper = [&](int axis, uint32_t cut) { return cut < 64 ? uint32_t(bits[axis] >> (63 - cut)) & 1u : 0u; };
+  uint32_t entry = 0, cut = 0;
+  for (uint32_t step = 0;; step = entry, ++cut) {
+    entry = steps_[step][upper(0, cut) | upper(1, cut) << 1 | upper(2, cut) << 2];
+    if (entry & kLeafEntry) break;
   }
-  return nodes_[n].leaf;
+  if (extent) {
+    // (`levels` cuts in all, in turn along x, y, z: a third of them along each, one more along the
+    // axes before `axis`.)
+    const uint32_t levels = 3 * cut + ((entry >> 29) & 3u), all = levels / 3, axis = levels % 3;
+    *extent = Vec3(std::ldexp(size.x, -int(all + (axis > 0))), std::ldexp(size.y, -int(all + (axis > 1))),
+                   std::ldexp(size.z, -int(all)));
+  }
+  return entry & ((1u << 29) - 1);
 }
 
-void SpatialTree::record_at(uint32_t leaf, Vec2 square, float value, float dither) {
+void SpatialTree::index_nodes() {
+  TESSERA_CHECK(leaves_.size() < (size_t(1) << 29));
+  steps_.clear();
+  (void)make_step(0);
+}
+
+uint32_t SpatialTree::make_step(uint32_t node) {
+  const uint32_t step = uint32_t(steps_.size());
+  steps_.emplace_back();
+  for (uint32_t e = 0; e < 8; ++e) {
+    uint32_t n = node, levels = 0;
+    for (; levels < 3 && nodes_[n].leaf == kNoLeaf; ++levels) n = nodes_[n].child[(e >> levels) & 1u];
+    const uint32_t entry = nodes_[n].leaf != kNoLeaf ? kLeafEntry | levels << 29 | nodes_[n].leaf : make_step(n);
+    steps_[step][e] = entry;
+  }
+  return step;
+}
+
+void SpatialTree::record_at(uint32_t leaf, Vec2 square, float value, float dither, DirectionalFilter filter) {
   Leaf& l = leaves_[leaf];
   std::atomic_ref<uint64_t>(l.samples).fetch_add(1, std::memory_order_relaxed);
-  l.building.record_at(square, value, dither);
+  if (filter == DirectionalFilter::Box)
+    l.building.record_box(square, value, dither);
+  else
+    l.building.record_at(square, value, dither);
 }
 
 void SpatialTree::record_pixel(uint32_t leaf, float value, float dither) {
@@ -93,13 +122,38 @@ const char* guide_roulette_name(GuideRoulette r) {
   return "radiance";
 }
 
-bool parse_guide_roulette(const std::string& name, GuideRoulette& out) {
-  for (GuideRoulette r : {GuideRoulette::Throughput, GuideRoulette::Guided, GuideRoulette::Radiance})
-    if (name == guide_roulette_name(r)) {
-      out = r;
+namespace {
+
+// The one of `all` named `name` by `name_of`.
+template <typename E, size_t N>
+bool parse_named(const std::string& name, const E (&all)[N], const char* (*name_of)(E), E& out) {
+  for (E e : all)
+    if (name == name_of(e)) {
+      out = e;
       return true;
     }
   return false;
+}
+
+}  // namespace
+
+bool parse_guide_roulette(const std::string& name, GuideRoulette& out) {
+  constexpr GuideRoulette kAll[] = {GuideRoulette::Throughput, GuideRoulette::Guided, GuideRoulette::Radiance};
+  return parse_named(name, kAll, guide_roulette_name, out);
+}
+
+const char* spatial_filter_name(SpatialFilter f) { return f == SpatialFilter::Nearest ? "nearest" : "stochastic"; }
+
+const char* directional_filter_name(DirectionalFilter f) { return f == DirectionalFilter::Nearest ? "nearest" : "box"; }
+
+bool parse_spatial_filter(const std::string& name, SpatialFilter& out) {
+  constexpr SpatialFilter kAll[] = {SpatialFilter::Nearest, SpatialFilter::Stochastic};
+  return parse_named(name, kAll, spatial_filter_name, out);
+}
+
+bool parse_directional_filter(const std::string& name, DirectionalFilter& out) {
+  constexpr DirectionalFilter kAll[] = {DirectionalFilter::Nearest, DirectionalFilter::Box};
+  return parse_named(name, kAll, directional_filter_name, out);
 }
 
 double spatial_split_threshold(const GuidingSettings& settings, uint32_t iteration_spp) {
@@ -127,6 +181,7 @@ void SpatialTree::end_iteration(uint32_t iteration_spp, const GuidingSettings& s
     split(n);
     total += cost;
   }
+  index_nodes();
   for (Leaf& l : leaves_) {
     const size_t before = leaf_bytes(l);
     l.sampling = std::move(l.building);

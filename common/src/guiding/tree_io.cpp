@@ -135,14 +135,17 @@ struct TreeIo {
     const uint32_t count = r.get<uint32_t>();
     if (!r.ok || count == 0 || count > r.left() / 12) return false;
     t.nodes_.resize(count);
+    std::vector<bool> has_parent(count, false);  // (a tree: no node is reached twice)
     for (uint32_t i = 0; i < count; ++i) {
       SpatialTree::Node& n = t.nodes_[i];
       n.child[0] = r.get<uint32_t>();
       n.child[1] = r.get<uint32_t>();
       n.leaf = r.get<uint32_t>();
       if (n.leaf == SpatialTree::kNoLeaf)
-        for (uint32_t c : n.child)
-          if (c <= i || c >= count) return false;
+        for (uint32_t c : n.child) {
+          if (c <= i || c >= count || has_parent[c]) return false;
+          has_parent[c] = true;
+        }
     }
     return r.ok;
   }
@@ -176,6 +179,7 @@ struct TreeIo {
       error = "guide: not a well-formed SD-tree";
       return false;
     }
+    out.index_nodes();
     t = std::move(out);
     return true;
   }
@@ -184,6 +188,7 @@ struct TreeIo {
     SpatialTree out;
     out.bounds_ = t.bounds_;
     out.nodes_ = t.nodes_;
+    out.steps_ = t.steps_;
     out.leaves_.resize(t.leaves_.size());
     for (size_t i = 0; i < t.leaves_.size(); ++i) out.leaves_[i].building = t.leaves_[i].building.cleared();
     return out;

@@ -100,7 +100,7 @@ class PathIntegrator final : public Integrator {
       }
       if (!surface_step(scene, path, si, media, sampler, counters)) break;
     }
-    if (path.records) path.records->commit(*guide->records, path.L, sampler);
+    if (path.records) path.records->commit(*guide, path.L, sampler);
     return path.L;
   }
 
@@ -171,6 +171,12 @@ class PathIntegrator final : public Integrator {
       return true;
     }
     path.null_crossings = 0;
+    // Recorded where a direction is sampled at all (not at delta-only BSDFs). The leaf is found
+    // first and its data asked for: far in memory, it then arrives while the vertex does the rest.
+    const bool recorded = path.guide && bsdf && !bsdf->is_delta();
+    Vec3 extent;  // (of the leaf's region: the stochastic spatial filter's box)
+    const uint32_t leaf = recorded ? path.guide->tree->leaf_of(si.p, &extent) : 0;
+    if (recorded) path.guide->tree->prefetch_leaf(leaf);
     if (path.features && !path.features->depth_found) {
       path.features->depth_found = true;
       path.features->depth = length(si.p - path.camera_o);
@@ -182,12 +188,10 @@ class PathIntegrator final : public Integrator {
     if (!bsdf) return false;
     const Vec3 wo = si.to_local(wo_world);
     const BounceSamples u = BounceSamples::draw(sampler);
-    // Recorded where a direction is sampled at all (not at delta-only BSDFs); guided where the
-    // lobe is rough enough (guides_lobe).
-    const bool recorded = path.guide && !bsdf->is_delta();
-    const uint32_t leaf = recorded ? path.guide->tree->leaf_of(si.p) : 0;
+    // Guided where the lobe is rough enough (guides_lobe).
     const bool guided = recorded && path.guide->sample && guides_lobe(*bsdf, si);
     const DirectionalTree* guide = guided ? &path.guide->tree->sampling(leaf) : nullptr;
+    if (guide) guide->prefetch();  // (its descents come after the shadow ray)
     const float fraction = guide ? path.guide->tree->bsdf_fraction(leaf) : 1.f;
     if (!bsdf->is_delta()) {
       Vertex v;
@@ -213,7 +217,7 @@ class PathIntegrator final : public Integrator {
     if (!consistent_side(si, wi_world, bs.wi)) return false;
     path.throughput *= bs.weight;
     if (path.records && !bs.delta)
-      path.records->add(leaf, wi_world, bs.pdf, bs.weight.luminance() * bs.pdf,
+      path.records->add(si.p, extent, leaf, wi_world, bs.pdf, bs.weight.luminance() * bs.pdf,
                         guide ? std::optional(mixture) : std::nullopt, path.throughput, path.L);
     path.prev_pdf = bs.pdf;
     path.prev_delta = bs.delta;

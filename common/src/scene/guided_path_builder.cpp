@@ -65,15 +65,16 @@ void read_combination(BuildState& st, const SceneNode& node, GuidingSettings& g)
 
 void read_filters_and_loss(BuildState& st, const SceneNode& node, GuidingSettings& g) {
   const std::string spatial = name_in(node, "spatial_filter", "spatialFilter");
-  if (const std::string v = choice(node, spatial, "nearest", {"nearest", "stochastic", "box"}); v != "nearest")
-    st.ctx.unsupported(node.loc_of(spatial), "spatialFilter \"" + v + "\" of " + node.describe(), "nearest");
+  const std::string v = choice(node, spatial, "nearest", {"nearest", "stochastic", "box"});
+  // (Müller's deterministic box splats every record into each leaf its box overlaps.)
+  if (v == "box") st.ctx.unsupported(node.loc_of(spatial), "spatialFilter \"box\" of " + node.describe(), "stochastic");
+  g.spatial_filter = v == "nearest" ? SpatialFilter::Nearest : SpatialFilter::Stochastic;
   const std::string directional = name_in(node, "directional_filter", "directionalFilter");
-  if (const std::string v = choice(node, directional, "nearest", {"nearest", "box"}); v != "nearest")
-    st.ctx.unsupported(node.loc_of(directional), "directionalFilter \"" + v + "\" of " + node.describe(), "nearest");
+  (void)parse_directional_filter(choice(node, directional, "nearest", {"nearest", "box"}), g.directional_filter);
   const std::string loss = name_in(node, "bsdf_sampling_fraction_loss", "bsdfSamplingFractionLoss");
-  const std::string v = choice(node, loss, "none", {"none", "kl", "var"});
-  if (v == "var") st.ctx.unsupported(node.loc_of(loss), "bsdfSamplingFractionLoss \"var\" of " + node.describe(), "kl");
-  g.learn_bsdf_fraction = v != "none";
+  const std::string l = choice(node, loss, "none", {"none", "kl", "var"});
+  if (l == "var") st.ctx.unsupported(node.loc_of(loss), "bsdfSamplingFractionLoss \"var\" of " + node.describe(), "kl");
+  g.learn_bsdf_fraction = l != "none";
 }
 
 void read_notes(BuildState& st, const SceneNode& node) {

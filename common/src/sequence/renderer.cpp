@@ -35,8 +35,8 @@ class PathUnits final : public UnitRenderer {
     std::optional<PathGuide> guide;
     if (work.uses) {
       const auto& tree = static_cast<const GuideArtifact*>(sequencer.artifact(*work.uses))->tree();
-      guide = PathGuide{&tree, work.feeds ? &guide_->recorder() : nullptr, *work.uses > 0, work.feeds.has_value(),
-                        guide_->settings().roulette};
+      guide = PathGuide::of(&tree, work.feeds ? &guide_->recorder() : nullptr, *work.uses > 0, work.feeds.has_value(),
+                            guide_->settings());
     }
     const PassSamples samples = work.samples ? *work.samples : PassSamples::uniform(work.rect, work.sample_begin, work.sample_end);
     render_tile(scene_, *integrator_, work.rect, samples, seed_, result.tile, guide ? &*guide : nullptr, aovs_);

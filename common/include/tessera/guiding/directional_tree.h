@@ -20,6 +20,7 @@
 
 #include "tessera/core/vec.h"
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -51,6 +52,11 @@ class DirectionalTree {
   void record(Vec3 dir, float value, float dither) { record_at(direction_to_square(dir), value, dither); }
   /// The same at the direction's point on the square (direction_to_square, or where sample() drew it).
   void record_at(Vec2 square, float value, float dither);
+  /// DirectionalFilter::Box (Müller 2019): `value` spread over a square of the size of the leaf
+  /// cell at `square` about it, each leaf it overlaps taking its share of the square's area (the
+  /// part outside the unit square is dropped, as in Müller's code). Each share is rounded with the
+  /// same `dither`, which keeps every leaf's expected sum exact.
+  void record_box(Vec2 square, float value, float dither);
   /// Adds the sums of a tree of the same structure (the same refined() ancestry).
   void merge(const DirectionalTree& other);
   /// Makes the inner quadrants' sums the totals of their subtrees. Before sampling.
@@ -64,6 +70,14 @@ class DirectionalTree {
   float pdf(Vec3 dir) const { return pdf_at(direction_to_square(dir)); }
   /// The same at a point of the square.
   float pdf_at(Vec2 square) const;
+  /// Asks for the cells of the tree's top levels (its first, breadth first: refined()) to be
+  /// brought into the cache, ahead of a sample() or pdf_at() whose direction is not known yet: a
+  /// descent otherwise waits on memory at every level of a tree no recent path has used.
+  void prefetch() const {
+    const char* cells = reinterpret_cast<const char*>(cells_.data());
+    const size_t bytes = std::min(cells_.size(), kPrefetchCells) * sizeof(Cell);
+    for (size_t b = 0; b < bytes; b += 64) __builtin_prefetch(cells + b);
+  }
 
   /// The next iteration's tree (of a built tree): a quadrant whose share of the total energy is
   /// above `threshold` is split (to at most kMaxDepth), a subtree whose share is not is merged. A
@@ -95,11 +109,13 @@ class DirectionalTree {
     std::array<float, 4> density{1.f, 1.f, 1.f, 1.f};
     std::array<uint32_t, 4> child{};
   };
+  // The root and the two levels below it.
+  static constexpr size_t kPrefetchCells = 1 + 4 + 16;
   uint64_t build_node(uint32_t n);
+  // record_box below node `n`, whose region has corner (x, y) and side `size`.
+  void splat(uint32_t n, double x, double y, double size, const double box[3], double density, float dither);
   void set_cells();
   friend struct TreeIo;  // tree_io.h
-  void refine_into(DirectionalTree& out, uint32_t out_node, const Node* node, double scale, uint64_t energy,
-                   int depth, double threshold, bool keep_sums) const;
 
   std::vector<Node> nodes_;
   // A Cell per node, made by build() and when a tree is refined or read: every tree holds them.

@@ -13,6 +13,7 @@
 #include "tessera/guiding/bsdf_fraction.h"
 #include "tessera/guiding/directional_tree.h"
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -49,11 +50,34 @@ const char* guide_roulette_name(GuideRoulette r);
 /// False when `name` is none of guide_roulette_name()'s.
 [[nodiscard]] bool parse_guide_roulette(const std::string& name, GuideRoulette& out);
 
+/// Where a training record goes in space (Müller 2019's spatialFilter).
+enum class SpatialFilter : uint8_t {
+  /// The leaf of the vertex (Müller 2017).
+  Nearest,
+  /// The leaf at a point drawn uniformly from a box of the vertex's leaf's size about the vertex
+  /// ("stochastic"): a leaf also learns from its neighbours' edges, so small leaves are less noisy.
+  Stochastic,
+};
+/// How a training record spreads over directions (Müller 2019's directionalFilter).
+enum class DirectionalFilter : uint8_t {
+  /// Into the directional cell of its direction (Müller 2017).
+  Nearest,
+  /// Over a square of the size of that cell about the direction's point, each cell it overlaps
+  /// taking the share of the square's area it covers ("box").
+  Box,
+};
+const char* spatial_filter_name(SpatialFilter f);
+const char* directional_filter_name(DirectionalFilter f);
+/// False when `name` is none of the names above.
+[[nodiscard]] bool parse_spatial_filter(const std::string& name, SpatialFilter& out);
+[[nodiscard]] bool parse_directional_filter(const std::string& name, DirectionalFilter& out);
+
 struct GuidingSettings {
   /// c of the spatial split rule: a leaf is split at the end of an iteration of spp_k samples per
   /// pixel once its samples in it exceed c·sqrt(spp_k / 4) (Müller's sTreeThreshold, which his
-  /// plugin applies as c·sqrt(2^k·sppPerPass / 4)).
-  double spatial_threshold = 12000.0;
+  /// plugin applies as c·sqrt(2^k·sppPerPass / 4)). 4,000 goes with the directional box filter
+  /// (Müller 2019); his plugin's default, without filters, is 12,000.
+  double spatial_threshold = 4000.0;
   /// A direction quadrant is split when its share of its leaf's energy exceeds this (dTreeThreshold).
   double directional_threshold = 0.01;
   /// Cap on the memory of the whole tree.
@@ -72,6 +96,10 @@ struct GuidingSettings {
   /// (InverseVariance) How many of the last iterations the image combines (Müller: 4).
   int combined_iterations = 4;
   GuideRoulette roulette = GuideRoulette::Radiance;
+  /// Nearest: the stochastic filter let light leak through walls into the leaves beside a door
+  /// ajar (docs/performance.md).
+  SpatialFilter spatial_filter = SpatialFilter::Nearest;
+  DirectionalFilter directional_filter = DirectionalFilter::Box;
 };
 
 /// The samples a leaf must exceed in an iteration of `iteration_spp` samples per pixel to be split:
@@ -84,8 +112,16 @@ class SpatialTree {
   explicit SpatialTree(const Bounds3& bounds, float bsdf_fraction = 0.5f);
   SpatialTree() = default;  // (empty: to be read, tree_io.h)
 
-  /// The leaf whose region holds `p` (a point outside the bounds goes to the nearest region).
-  uint32_t leaf_of(Vec3 p) const;
+  /// The leaf whose region holds `p` (a point outside the bounds goes to the nearest region), and
+  /// if asked the size of that region.
+  uint32_t leaf_of(Vec3 p, Vec3* extent = nullptr) const;
+  /// Asks for the leaf's estimates and its trees' places to be brought into the cache.
+  void prefetch_leaf(uint32_t leaf) const {
+    __builtin_prefetch(&leaves_[leaf]);
+    __builtin_prefetch(&leaves_[leaf].bsdf_fraction);
+  }
+  /// Asks for the top of the leaf's recording tree to be brought into the cache (DirectionalTree::prefetch).
+  void prefetch_records(uint32_t leaf) const { leaves_[leaf].building.prefetch(); }
   /// The leaf's distribution learned in the previous iteration (uniform before the first).
   const DirectionalTree& sampling(uint32_t leaf) const { return leaves_[leaf].sampling; }
   /// Records radiance `value` arriving from `dir` in the leaf (see DirectionalTree::record) and
@@ -93,8 +129,10 @@ class SpatialTree {
   void record(uint32_t leaf, Vec3 dir, float value, float dither) {
     record_at(leaf, direction_to_square(dir), value, dither);
   }
-  /// The same at the direction's point on the square (DirectionalTree::record_at).
-  void record_at(uint32_t leaf, Vec2 square, float value, float dither);
+  /// The same at the direction's point on the square (DirectionalTree::record_at, or record_box
+  /// with DirectionalFilter::Box).
+  void record_at(uint32_t leaf, Vec2 square, float value, float dither,
+                 DirectionalFilter filter = DirectionalFilter::Nearest);
   /// Records the luminance of a path's estimate (a pixel sample) whose first recorded vertex is in
   /// the leaf. Thread-safe against other record calls.
   void record_pixel(uint32_t leaf, float value, float dither);
@@ -139,12 +177,20 @@ class SpatialTree {
     bool operator==(const Leaf&) const = default;
   };
   void split(uint32_t node);
+  // leaf_of()'s view of the nodes, three cuts (along x, y, z) per step so that its chain of
+  // dependent loads is a third as long: entry e of a step (bit 0 set: the upper half along x, bit
+  // 1: y, bit 2: z) is the next step, or kLeafEntry | levels << 29 | leaf for a leaf reached after
+  // `levels` (0 to 3) of the step's cuts. Made again whenever the nodes change.
+  static constexpr uint32_t kLeafEntry = 1u << 31;
+  void index_nodes();
+  uint32_t make_step(uint32_t node);
   static size_t leaf_bytes(const Leaf& leaf);
   friend struct TreeIo;  // tree_io.h
 
   Bounds3 bounds_;
   std::vector<Node> nodes_;
   std::vector<Leaf> leaves_;
+  std::vector<std::array<uint32_t, 8>> steps_;
 };
 
 }  // namespace tessera

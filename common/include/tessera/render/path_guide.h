@@ -32,6 +32,15 @@ struct PathGuide {
   bool train = false;                 // record the pass's radiance into `records`
   /// Russian roulette once the guide samples (before, by throughput).
   GuideRoulette roulette = GuideRoulette::Throughput;
+  /// Where training records go (GuidingSettings).
+  SpatialFilter spatial_filter = SpatialFilter::Nearest;
+  DirectionalFilter directional_filter = DirectionalFilter::Nearest;
+
+  /// A pass's guide as `settings` ask (the one way the renderer and the farm's worker make it).
+  static PathGuide of(const SpatialTree* tree, SpatialTree* records, bool sample, bool train,
+                      const GuidingSettings& settings) {
+    return {tree, records, sample, train, settings.roulette, settings.spatial_filter, settings.directional_filter};
+  }
 };
 
 /// The vertices of one path that sampled a direction to record, and at the path's end the
@@ -43,24 +52,29 @@ class GuideRecords {
   static constexpr uint32_t kDitherDimension = 0xFFFFFE00u;
   /// The dither of the pixel sample.
   static constexpr uint32_t kPixelDitherDimension = kDitherDimension + kCapacity;
+  /// Dimension of vertex k's jitter of the stochastic spatial filter: kJitterDimension + k, whose
+  /// value's bits are hashed into the three coordinates (the jitter need not be stratified, and a
+  /// sample value costs its scrambling hashes).
+  static constexpr uint32_t kJitterDimension = kPixelDitherDimension + 1;
 
-  /// A vertex in `leaf` sampled `wi` (world) with density `pdf`, where the BSDF's f * cos has
+  /// A vertex at `p` in `leaf` (whose region's size is `extent`) sampled `wi` (world) with density `pdf`, where the BSDF's f * cos has
   /// luminance `f_cos`; `throughput` is the path's after the vertex's weight (before Russian
   /// roulette), `radiance` the camera's estimate so far. `mixture` holds the two pdfs of a guided
   /// vertex (none when the guide did not sample).
-  void add(uint32_t leaf, Vec3 wi, float pdf, float f_cos, std::optional<MixturePdfs> mixture, const Rgb& throughput,
-           const Rgb& radiance) {
+  void add(Vec3 p, Vec3 extent, uint32_t leaf, Vec3 wi, float pdf, float f_cos, std::optional<MixturePdfs> mixture,
+           const Rgb& throughput, const Rgb& radiance) {
     if (count_ >= kCapacity) return;
     // (A guided vertex knows where wi lies on the guide's square; otherwise it is mapped here.)
     const Vec2 square = mixture ? mixture->square : direction_to_square(wi);
-    vertices_[size_t(count_++)] = {leaf, square, pdf, f_cos, mixture, throughput, radiance};
+    vertices_[size_t(count_++)] = {p, extent, leaf, square, pdf, f_cos, mixture, throughput, radiance};
   }
-  /// Records every vertex into `tree` once the path's estimate is `radiance`, and that estimate as
-  /// a pixel sample at the first vertex's leaf.
-  void commit(SpatialTree& tree, const Rgb& radiance, Sampler& sampler) const;
+  /// Records every vertex into `guide.records` (through its filters) once the path's estimate is
+  /// `radiance`, and that estimate as a pixel sample at the first vertex's leaf.
+  void commit(const PathGuide& guide, const Rgb& radiance, Sampler& sampler) const;
 
  private:
   struct Vertex {
+    Vec3 p, extent;
     uint32_t leaf;
     Vec2 square;  // wi's point on the guide's square
     float pdf, f_cos;
