@@ -40,7 +40,7 @@ struct SquareBits {
 
 // The angle of (x, y) about the origin in [0, 2 pi]: the arc tangent of the smaller over the larger
 // magnitude (in [0, 1]) by a polynomial fitted to within 2.5e-7 radians (about float's rounding of
-// an angle near 2 pi), then mirrored into its octant; a third of libm's atan2f's time.
+// an angle near 2 pi), then mirrored into its octant: no call into libm on the hot path.
 float azimuth(float x, float y) {
   const float ax = std::abs(x), ay = std::abs(y);
   const float hi = std::max(ax, ay), t = hi > 0.f ? std::min(ax, ay) / hi : 0.f, t2 = t * t;

@@ -175,7 +175,7 @@ class PathIntegrator final : public Integrator {
     // first and its data asked for: far in memory, it then arrives while the vertex does the rest.
     const bool recorded = path.guide && bsdf && !bsdf->is_delta();
     Vec3 extent;  // (of the leaf's region: the stochastic spatial filter's box)
-    const uint32_t leaf = recorded ? path.guide->tree->leaf_of(si.p, &extent) : 0;
+    const uint32_t leaf = recorded ? path.guide->tree->leaf_of(si.p, path.records ? &extent : nullptr) : 0;
     if (recorded) path.guide->tree->prefetch_leaf(leaf);
     if (path.features && !path.features->depth_found) {
       path.features->depth_found = true;
