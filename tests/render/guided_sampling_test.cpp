@@ -1,7 +1,7 @@
 // Path guiding's mixture of BSDF and guided sampling (render/guided_sampling.h): its samples follow
 // its pdf (chi-square) for diffuse and rough metal BSDFs and a trained guide, its weight is
-// eval / pdf, a delta lobe keeps the BSDF's weight for the probability of choosing the BSDF, and
-// only lobes rough enough are guided.
+// eval / pdf, a delta lobe keeps the BSDF's weight for the probability of choosing the BSDF, a
+// fraction of one is the BSDF's own sampling, and only lobes rough enough are guided.
 #include "tessera/render/guided_sampling.h"
 
 #include "support/chi2.h"
@@ -93,6 +93,32 @@ TEST(GuidedSampling, ADeltaLobeKeepsTheBsdfWeightOverTheChoice) {
   EXPECT_EQ(guided.wi, plain.wi);
   EXPECT_FLOAT_EQ(guided.weight.g, plain.weight.g / 0.5f);
   EXPECT_FLOAT_EQ(guided.pdf, plain.pdf * 0.5f);
+}
+
+TEST(GuidedSampling, AFractionOfOneIsTheBsdfsOwnSampling) {
+  // A leaf that learned the guide does not help samples as the unguided path tracer does, bit for
+  // bit, and its pdf is the BSDF's; only the parts (for the fraction's loss and the roulette) ask
+  // the guide.
+  const DirectionalTree guide = guide_towards(normalize(Vec3(0.2f, -0.3f, 0.9f)));
+  const auto plastic = make_roughplastic_bsdf(MicrofacetType::Ggx, 0.4f, 1.5f, constant(0.5f), constant(1.f), false);
+  const Vec3 wo = normalize(Vec3(0.4f, 0.1f, 0.7f));
+  const SurfaceInteraction si;
+  Pcg32 rng(9);
+  for (int k = 0; k < 2000; ++k) {
+    const float u_lobe = rng.next_float();
+    const Vec2 u(rng.next_float(), rng.next_float());
+    BsdfSample plain, guided;
+    MixturePdfs parts;
+    const bool sampled = plastic->sample(si, wo, u_lobe, u, plain);
+    ASSERT_EQ(sample_guided(*plastic, si, wo, guide, 1.f, u_lobe, u, guided, &parts), sampled);
+    if (!sampled) continue;
+    ASSERT_EQ(guided.wi, plain.wi);
+    ASSERT_EQ(guided.pdf, plain.pdf);
+    ASSERT_EQ(guided.weight.g, plain.weight.g);
+    ASSERT_EQ(guided_pdf(*plastic, si, wo, guided.wi, guide, 1.f), plastic->pdf(si, wo, guided.wi));
+    ASSERT_EQ(parts.guide, guide.pdf_at(parts.square));
+    ASSERT_GT(parts.guide, 0.f);
+  }
 }
 
 TEST(GuidedSampling, OnlyLobesRoughEnoughAreGuided) {

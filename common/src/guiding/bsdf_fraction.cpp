@@ -22,10 +22,12 @@ void BsdfFractionLoss::record(float weight, float bsdf_pdf, float guide_pdf) {
   if (!(weight > 0.f)) return;
   const double w = std::min(weight, kMaxWeight);
   for (int i = 0; i < kCandidates; ++i) {
-    const double alpha = candidate(i);
-    const double p = alpha * double(bsdf_pdf) + (1.0 - alpha) * double(guide_pdf);
-    const double term = p > 0.0 ? std::clamp(-w * std::log(p) * kScale, -kMaxTerm, kMaxTerm) : kUnreachable;
-    std::atomic_ref<int64_t>(loss_[size_t(i)]).fetch_add(std::llround(term), std::memory_order_relaxed);
+    // (In float: the argmin needs a few digits, and a record is ten logarithms.)
+    const float alpha = candidate(i);
+    const float p = alpha * bsdf_pdf + (1.f - alpha) * guide_pdf;
+    const double term = p > 0.f ? std::clamp(-w * double(std::log(p)) * kScale, -kMaxTerm, kMaxTerm) : kUnreachable;
+    const int64_t rounded = int64_t(term < 0.0 ? term - 0.5 : term + 0.5);  // (to nearest, as llround)
+    std::atomic_ref<int64_t>(loss_[size_t(i)]).fetch_add(rounded, std::memory_order_relaxed);
   }
   std::atomic_ref<uint64_t>(records_).fetch_add(1, std::memory_order_relaxed);
 }

@@ -75,7 +75,7 @@ void DirectionalTree::record_at(Vec2 p, float value, float dither) {
   const SquareBits bits(p);
   for (uint32_t n = 0, depth = 0;; ++depth) {
     const int i = bits.quadrant(int(depth));
-    const uint32_t c = cells_[n].child[size_t(i)];
+    const uint32_t c = nodes_[n].child[size_t(i)];
     if (c == 0) {
       std::atomic_ref<uint64_t>(nodes_[n].sum[size_t(i)]).fetch_add(q, std::memory_order_relaxed);
       return;
@@ -88,7 +88,7 @@ void DirectionalTree::record_box(Vec2 p, float value, float dither) {
   if (!(value > 0.f)) return;
   const SquareBits bits(p);
   int depth = 0;  // (of the node whose quadrant holds p: the quadrant's side is 2^-(depth + 1))
-  for (uint32_t n = 0; (n = cells_[n].child[size_t(bits.quadrant(depth))]) != 0;) ++depth;
+  for (uint32_t n = 0; (n = nodes_[n].child[size_t(bits.quadrant(depth))]) != 0;) ++depth;
   const double side = std::ldexp(1.0, -(depth + 1));
   const double box[3] = {double(p.x) - side / 2, double(p.y) - side / 2, side};
   splat(0, 0.0, 0.0, 1.0, box, double(std::min(value, kMaxRecord)) / (side * side), dither);
@@ -102,7 +102,7 @@ void DirectionalTree::splat(uint32_t n, double x, double y, double size, const d
     const double qx = x + ((i & 1) ? half : 0.0), qy = y + ((i & 2) ? half : 0.0);
     const double wx = overlap(qx, box[0]), wy = overlap(qy, box[1]);
     if (!(wx > 0.0) || !(wy > 0.0)) continue;
-    if (const uint32_t c = cells_[n].child[i]) {
+    if (const uint32_t c = nodes_[n].child[i]) {
       splat(c, qx, qy, half, box, density, dither);
     } else if (const uint64_t q = fixed_point(float(density * wx * wy), dither)) {
       std::atomic_ref<uint64_t>(nodes_[n].sum[i]).fetch_add(q, std::memory_order_relaxed);

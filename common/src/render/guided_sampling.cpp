@@ -20,6 +20,7 @@ float mix(const MixturePdfs& p, float bsdf_fraction) {
 
 float guided_pdf(const Bsdf& bsdf, const SurfaceInteraction& si, Vec3 wo, Vec3 wi, const DirectionalTree& guide,
                  float bsdf_fraction) {
+  if (bsdf_fraction >= 1.f) return bsdf.pdf(si, wo, wi);  // (the guide's term is zero: no descent)
   return mix(mixture_pdfs(bsdf, si, wo, wi, direction_to_square(si.to_world(wi)), guide), bsdf_fraction);
 }
 
@@ -37,6 +38,12 @@ bool sample_guided(const Bsdf& bsdf, const SurfaceInteraction& si, Vec3 wo, cons
       return true;
     }
     square = direction_to_square(si.to_world(out.wi));
+    if (bsdf_fraction >= 1.f) {
+      // The mixture is the BSDF's own sampling, whose pdf and weight stand; the guide's density
+      // is only asked for the parts.
+      if (parts) *parts = {out.pdf, guide.pdf_at(square), square};
+      return true;
+    }
     pdfs = mixture_pdfs(bsdf, si, wo, out.wi, square, guide);
   } else {
     // The guide's density at the point it drew (pdf_at() there, without its descent), not at the

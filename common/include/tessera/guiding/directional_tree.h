@@ -78,6 +78,12 @@ class DirectionalTree {
     const size_t bytes = std::min(cells_.size(), kPrefetchCells) * sizeof(Cell);
     for (size_t b = 0; b < bytes; b += 64) __builtin_prefetch(cells + b);
   }
+  /// The same for a record() (which reads and adds to the nodes, not the cells).
+  void prefetch_records() const {
+    const char* nodes = reinterpret_cast<const char*>(nodes_.data());
+    const size_t bytes = std::min(nodes_.size(), kPrefetchCells) * sizeof(Node);
+    for (size_t b = 0; b < bytes; b += 64) __builtin_prefetch(nodes + b, 1);
+  }
 
   /// The next iteration's tree (of a built tree): a quadrant whose share of the total energy is
   /// above `threshold` is split (to at most kMaxDepth), a subtree whose share is not is merged. A

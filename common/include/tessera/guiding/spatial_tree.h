@@ -120,8 +120,8 @@ class SpatialTree {
     __builtin_prefetch(&leaves_[leaf]);
     __builtin_prefetch(&leaves_[leaf].bsdf_fraction);
   }
-  /// Asks for the top of the leaf's recording tree to be brought into the cache (DirectionalTree::prefetch).
-  void prefetch_records(uint32_t leaf) const { leaves_[leaf].building.prefetch(); }
+  /// Asks for the top of the leaf's recording tree to be brought into the cache (DirectionalTree::prefetch_records).
+  void prefetch_records(uint32_t leaf) const { leaves_[leaf].building.prefetch_records(); }
   /// The leaf's distribution learned in the previous iteration (uniform before the first).
   const DirectionalTree& sampling(uint32_t leaf) const { return leaves_[leaf].sampling; }
   /// Records radiance `value` arriving from `dir` in the leaf (see DirectionalTree::record) and

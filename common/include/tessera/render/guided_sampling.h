@@ -5,7 +5,9 @@
 // and the weight eval(wi) / pdf(wi) (eval includes the cosine, bsdf.h). A delta lobe the BSDF picks
 // is outside the mixture: its pdf and weight are the BSDF's, for the probability of choosing the
 // BSDF. The lobe dimension `u_lobe` also makes the choice (rescaled for the BSDF), so guiding
-// draws no dimension the unguided path does not (sampler.h). Hot path: no throw, no allocation.
+// draws no dimension the unguided path does not (sampler.h). Where the fraction is 1 (a leaf that
+// learned the guide does not help, as half of cornell-box's do) the mixture is the BSDF's own
+// sampling, and neither function descends the guide for it. Hot path: no throw, no allocation.
 #pragma once
 
 #include "tessera/guiding/directional_tree.h"

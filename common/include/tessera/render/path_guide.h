@@ -7,8 +7,8 @@
 // luminance(Li) / p, an estimate of the incident radiance integrated over the leaf's cells, at wi.
 // A guided vertex also records luminance(f * cos * Li) / p with the mixture's two pdfs there, the
 // loss from which its leaf learns the BSDF fraction (guiding/bsdf_fraction.h).
-// Its rounding dither comes from a dedicated sampler dimension per vertex (sampler.h), so the
-// statistics are a function of (pixel, sample index, seed) like every sample value.
+// Its rounding dither comes from a stream seeded by a dedicated sampler dimension (sampler.h), so
+// the statistics are a function of (pixel, sample index, seed) like every sample value.
 #pragma once
 
 #include "tessera/core/rgb.h"
@@ -48,14 +48,9 @@ struct PathGuide {
 class GuideRecords {
  public:
   static constexpr int kCapacity = 32;
-  /// Dimensions of the dither of vertex k: kDitherDimension + k (far from the sequential ones).
-  static constexpr uint32_t kDitherDimension = 0xFFFFFE00u;
-  /// The dither of the pixel sample.
-  static constexpr uint32_t kPixelDitherDimension = kDitherDimension + kCapacity;
-  /// Dimension of vertex k's jitter of the stochastic spatial filter: kJitterDimension + k, whose
-  /// value's bits are hashed into the three coordinates (the jitter need not be stratified, and a
-  /// sample value costs its scrambling hashes).
-  static constexpr uint32_t kJitterDimension = kPixelDitherDimension + 1;
+  /// The dimension whose value seeds a path's dithers (of the pixel sample and of each vertex's
+  /// record) and its stochastic spatial filter's jitter (far from the sequential dimensions).
+  static constexpr uint32_t kRecordDimension = 0xFFFFFE00u;
 
   /// A vertex at `p` in `leaf` (whose region's size is `extent`) sampled `wi` (world) with density `pdf`, where the BSDF's f * cos has
   /// luminance `f_cos`; `throughput` is the path's after the vertex's weight (before Russian
@@ -66,7 +61,7 @@ class GuideRecords {
     if (count_ >= kCapacity) return;
     // (A guided vertex knows where wi lies on the guide's square; otherwise it is mapped here.)
     const Vec2 square = mixture ? mixture->square : direction_to_square(wi);
-    vertices_[size_t(count_++)] = {p, extent, leaf, square, pdf, f_cos, mixture, throughput, radiance};
+    vertices_.at[size_t(count_++)] = {p, extent, leaf, square, pdf, f_cos, mixture, throughput, radiance};
   }
   /// Records every vertex into `guide.records` (through its filters) once the path's estimate is
   /// `radiance`, and that estimate as a pixel sample at the first vertex's leaf.
@@ -81,7 +76,12 @@ class GuideRecords {
     std::optional<MixturePdfs> mixture;
     Rgb throughput, radiance;
   };
-  std::array<Vertex, kCapacity> vertices_;
+  // Left unmade: every path of a guided render makes a GuideRecords, and zeroing its 2.8 KB cost
+  // more than most paths' records. (Assigning an element begins its life: Vertex is an aggregate.)
+  union Storage {
+    Storage() {}
+    Vertex at[kCapacity];
+  } vertices_;
   int count_ = 0;
 };
 
