@@ -4,6 +4,7 @@
 #include "tessera/render/sampler.h"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 
 namespace tessera {

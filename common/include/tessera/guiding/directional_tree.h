@@ -73,17 +73,9 @@ class DirectionalTree {
   /// Asks for the cells of the tree's top levels (its first, breadth first: refined()) to be
   /// brought into the cache, ahead of a sample() or pdf_at() whose direction is not known yet: a
   /// descent otherwise waits on memory at every level of a tree no recent path has used.
-  void prefetch() const {
-    const char* cells = reinterpret_cast<const char*>(cells_.data());
-    const size_t bytes = std::min(cells_.size(), kPrefetchCells) * sizeof(Cell);
-    for (size_t b = 0; b < bytes; b += 64) __builtin_prefetch(cells + b);
-  }
+  void prefetch() const { prefetch_top<false>(cells_); }
   /// The same for a record() (which reads and adds to the nodes, not the cells).
-  void prefetch_records() const {
-    const char* nodes = reinterpret_cast<const char*>(nodes_.data());
-    const size_t bytes = std::min(nodes_.size(), kPrefetchCells) * sizeof(Node);
-    for (size_t b = 0; b < bytes; b += 64) __builtin_prefetch(nodes + b, 1);
-  }
+  void prefetch_records() const { prefetch_top<true>(nodes_); }
 
   /// The next iteration's tree (of a built tree): a quadrant whose share of the total energy is
   /// above `threshold` is split (to at most kMaxDepth), a subtree whose share is not is merged. A
@@ -117,6 +109,13 @@ class DirectionalTree {
   };
   // The root and the two levels below it.
   static constexpr size_t kPrefetchCells = 1 + 4 + 16;
+  // Asks for the first kPrefetchCells elements of `v` (for writing, with `kWrite`).
+  template <bool kWrite, typename T>
+  static void prefetch_top(const std::vector<T>& v) {
+    const char* first = reinterpret_cast<const char*>(v.data());
+    const size_t bytes = std::min(v.size(), kPrefetchCells) * sizeof(T);
+    for (size_t b = 0; b < bytes; b += 64) __builtin_prefetch(first + b, kWrite ? 1 : 0);
+  }
   uint64_t build_node(uint32_t n);
   // record_box below node `n`, whose region has corner (x, y) and side `size`.
   void splat(uint32_t n, double x, double y, double size, const double box[3], double density, float dither);

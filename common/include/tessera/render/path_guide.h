@@ -16,7 +16,6 @@
 #include "tessera/guiding/spatial_tree.h"
 #include "tessera/render/guided_sampling.h"
 
-#include <array>
 #include <cstdint>
 #include <optional>
 
