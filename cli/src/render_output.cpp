@@ -116,9 +116,13 @@ void print_render_report(const RenderOptions& options, const Scene& scene, const
                double(c.rays()) / std::max(stats.seconds, 1e-9));
   if (c.nonfinite > 0) std::fprintf(stderr, "; %llu NaN/Inf samples dropped", (unsigned long long)c.nonfinite);
   std::fprintf(stderr, "\n");
-  if (stats.guide_leaves > 0)
-    std::fprintf(stderr, "guide: %zu spatial leaves, %.1f MB (cap %.0f MB)\n", stats.guide_leaves,
-                 double(stats.guide_bytes) / 1e6, double(guide_plan(scene, settings.guiding)->settings.max_bytes) / 1e6);
+  if (stats.guide_stepped_aside)
+    std::fprintf(stderr, "guide: stepped aside, its predicted gain %.3g below the least of %g: the rest rendered unguided\n",
+                 double(stats.guide_gain), guide_plan(scene, settings.guiding)->settings.min_gain);
+  else if (stats.guide_leaves > 0)
+    std::fprintf(stderr, "guide: %zu spatial leaves, %.1f MB (cap %.0f MB), predicted gain %.3g\n", stats.guide_leaves,
+                 double(stats.guide_bytes) / 1e6, double(guide_plan(scene, settings.guiding)->settings.max_bytes) / 1e6,
+                 double(stats.guide_gain));
   if (const std::optional<PointMapPlan> points = point_map_plan(scene))
     std::fprintf(stderr, "%s: initial radius %.4g (%s), alpha %.3g\n", integrator_name(points->type),
                  double(points->initial_radius), scene.integrator.initial_radius > 0.f ? "the scene's" : "automatic",

@@ -45,7 +45,11 @@ json to_json(const JobStatus& s) {
             {"stopped_at_target", s.stopped_at_target}};
   j["denoise_state"] = s.denoise_state.empty() ? json(nullptr) : json(s.denoise_state);
   j["denoise_error"] = s.denoise_error.empty() ? json(nullptr) : json(s.denoise_error);
-  j["guide"] = s.guide ? json{{"iterations", s.guide->iterations}, {"leaves", s.guide->leaves}, {"bytes", s.guide->bytes}}
+  j["guide"] = s.guide ? json{{"iterations", s.guide->iterations},
+                              {"leaves", s.guide->leaves},
+                              {"bytes", s.guide->bytes},
+                              {"predicted_gain", s.guide->predicted_gain},
+                              {"stepped_aside", s.guide->stepped_aside}}
                        : json(nullptr);
   j["point_map"] = s.point_map ? json{{"iterations", s.point_map->iterations}, {"bytes", s.point_map->bytes}} : json(nullptr);
   // (Left out rather than null when the lease log could not be read, as before.)

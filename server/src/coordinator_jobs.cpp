@@ -337,7 +337,9 @@ JobStatus Coordinator::Impl::status_of(const JobState& job) {
   s.target_error = p.settings.target_error;
   s.spp_done = job.spp_complete();
   s.stopped_at_target = job.converged();
-  if (const GuideTraining* g = job.guide()) s.guide = JobStatus::Guide{job.guide_iterations(), g->tree_leaves(), g->tree_bytes()};
+  if (const GuideTraining* g = job.guide())
+    s.guide = JobStatus::Guide{job.guide_iterations(), g->tree_leaves(), g->tree_bytes(), g->predicted_gain(),
+                               g->stepped_aside()};
   if (p.points) s.point_map = JobStatus::PointMap{job.sequencer().artifacts_stored(), job.latest_map_bytes};
   return s;
 }

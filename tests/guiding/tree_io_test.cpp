@@ -20,6 +20,7 @@ void record_some(SpatialTree& tree, int n, uint64_t seed) {
                 rng.next_float());
     tree.record_fraction(leaf, rng.next_float(), rng.next_float(), rng.next_float());
     if (k % 3 == 0) tree.record_pixel(leaf, rng.next_float() * 2.f, rng.next_float());
+    if (k % 5 == 0) tree.record_gain(rng.next_float() * 4.0, rng.next_float(), rng.next_float());
   }
 }
 
@@ -31,6 +32,7 @@ SpatialTree trained_tree() {
   SpatialTree tree(box);
   GuidingSettings s;
   s.spatial_threshold = 300;
+  s.gain_paths = 1;  // (a few hundred paths decide)
   for (int it = 0; it < 3; ++it) {
     record_some(tree, 4000, uint64_t(it));
     tree.end_iteration(4u << it, s);
@@ -45,6 +47,28 @@ TEST(TreeIo, ATreeReadsBackAsItself) {
   std::string error;
   ASSERT_TRUE(read_tree(write_tree(tree), back, error)) << error;
   EXPECT_TRUE(back == tree);
+}
+
+TEST(TreeIo, AGuideThatSteppedAsideReadsBackAsItself) {
+  SpatialTree tree = trained_tree();
+  EXPECT_GT(tree.predicted_gain(), 1.3f) << "decided at the iteration of 8 spp, and kept guiding";
+  GuidingSettings s;
+  s.min_gain = 1e6;
+  s.gain_paths = 1;
+  for (int k = 0; k < 10; ++k) tree.record_gain(1.0, 1.0, 0.5f);
+  SpatialTree fresh = tree;
+  SpatialTree never_decided(Bounds3(Vec3(0.f), Vec3(1.f)));
+  for (int k = 0; k < 10; ++k) never_decided.record_gain(1.0, 1.0, 0.5f);
+  never_decided.end_iteration(8, s);
+  ASSERT_TRUE(never_decided.stepped_aside());
+  SpatialTree back;
+  std::string error;
+  ASSERT_TRUE(read_tree(write_tree(never_decided), back, error)) << error;
+  EXPECT_TRUE(back == never_decided);
+  EXPECT_TRUE(back.stepped_aside());
+  EXPECT_FLOAT_EQ(back.predicted_gain(), 1.f);
+  fresh.end_iteration(32, s);
+  EXPECT_FALSE(fresh.stepped_aside()) << "decided once";
 }
 
 TEST(TreeIo, RecordsSplitAmongRecordersAddUpToRecordingEverything) {

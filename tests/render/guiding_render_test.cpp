@@ -117,6 +117,33 @@ TEST(GuidedRender, AnIterationIsARunOfPassesWithOneGuide) {
 
 // Leaves split once their samples in an iteration of spp_k samples a pixel exceed c·sqrt(spp_k / 4):
 // the sequencer passes each iteration's samples to the tree.
+// Where the guide cannot pay (cornell-box: next-event estimation finds its one light) its
+// prediction is below the least gain and the render steps aside; through a window pane the light
+// is found only by the guide, and it keeps guiding. Both at 96x72 and 128 spp, deciding at the
+// first iteration of 2^17 paths (32 spp).
+TEST(GuidedRender, StepsAsideWhereTheGuidePredictsLittleAndNotWhereItPredictsMuch) {
+  const std::string cornell = shared_path("scenes/cornell-box/scene.xml");
+  TESSERA_REQUIRE_FILE(cornell);
+  LoadOptions o;
+  o.width = 96;
+  o.height = 72;
+  const std::unique_ptr<Scene> direct = std::move(load_scene(parse_scene_file(cornell), o).scene);
+  const std::unique_ptr<Scene> window =
+      std::move(load_scene(parse_scene_file(source_dir() + "/scenes/window-pane/scene.xml"), o).scene);
+  RenderSettings s = render_settings(128, 3);
+  s.guiding = true;
+  s.guiding_settings.emplace().gain_paths = uint64_t(1) << 17;
+  RenderStats direct_stats, window_stats;
+  (void)render(*direct, s, {}, &direct_stats);
+  (void)render(*window, s, {}, &window_stats);
+  EXPECT_TRUE(direct_stats.guide_stepped_aside) << "predicted " << direct_stats.guide_gain;
+  EXPECT_GT(direct_stats.guide_gain, 0.f);
+  EXPECT_LT(direct_stats.guide_gain, 1.3f);
+  EXPECT_EQ(direct_stats.guide_leaves, 1u);
+  EXPECT_FALSE(window_stats.guide_stepped_aside) << "predicted " << window_stats.guide_gain;
+  EXPECT_GT(window_stats.guide_gain, 1.3f);
+}
+
 TEST(GuidedRender, TheSplitThresholdFollowsTheIterationsSamples) {
   PathProgramOptions o;
   o.spp = 16;  // iterations 1 2 4 9

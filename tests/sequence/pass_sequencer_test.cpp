@@ -218,6 +218,24 @@ TEST(PassSequencer, PerIterationFilmsAreCombinedByInverseVariance) {
   EXPECT_NE(e0, e1) << "the films weigh differently";
 }
 
+// Films whose passes render as one estimator (a technique that stepped aside) weigh as one film,
+// in proportion to their samples: here both films (film 0's last pass uses artifact 1), of 2 + 2 +
+// 2 and 3 + 4 + 4 samples per pixel.
+TEST(PassSequencer, FilmsOfOneEstimatorWeighByTheirSamples) {
+  PassSequencer seq = toy_sequencer(everything_program(), 8);
+  ToyUnits units(kSeed);
+  run_locally(seq, units, 2);
+  seq.films().set_alike_from(1);
+  const Image combined = seq.films().image();
+  const Image i0 = film_image(seq, 0), i1 = film_image(seq, 1);
+  for (int y = 0; y < combined.height(); ++y)
+    for (int x = 0; x < combined.width(); ++x)
+      for (int c = 0; c < 3; ++c) {
+        const double expect = 6.0 / 17.0 * double(i0.at(x, y, c)) + 11.0 / 17.0 * double(i1.at(x, y, c));
+        ASSERT_NEAR(combined.at(x, y, c), expect, 1e-5 * std::abs(expect) + 1e-7) << x << "," << y;
+      }
+}
+
 TEST(PassSequencer, StopsAtTheTargetErrorAsARenderOfTheSamplesReached) {
   PassProgram program;
   program.spp = 24;

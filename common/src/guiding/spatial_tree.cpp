@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <limits>
 
 namespace tessera {
 
@@ -161,6 +162,12 @@ double spatial_split_threshold(const GuidingSettings& settings, uint32_t iterati
 }
 
 void SpatialTree::end_iteration(uint32_t iteration_spp, const GuidingSettings& settings) {
+  ++iteration_;
+  if (stepped_aside_) return;
+  if (decide_gain(iteration_spp, settings)) {
+    step_aside();
+    return;
+  }
   const double threshold = spatial_split_threshold(settings, iteration_spp);
   // The estimates first: a split leaf's halves keep its trees whole but half its samples.
   for (Leaf& l : leaves_) {
@@ -194,10 +201,41 @@ void SpatialTree::end_iteration(uint32_t iteration_spp, const GuidingSettings& s
     if (settings.learn_bsdf_fraction) l.bsdf_fraction = l.fraction_loss.best(l.bsdf_fraction, settings.min_bsdf_fraction);
     l.fraction_loss = {};
   }
+  update_gain_scale();  // (of the leaves as split: what a tree read from bytes computes again)
+}
+
+bool SpatialTree::decide_gain(uint32_t iteration_spp, const GuidingSettings& settings) {
+  const GuideGain gain = gain_;
+  gain_ = {};
+  // (Once: a guide that paid at the deciding iteration is not asked again.)
+  if (!(settings.min_gain > 0.0) || predicted_gain_ > 0.f || iteration_spp < settings.gain_iteration_spp ||
+      gain.paths < std::max<uint64_t>(settings.gain_paths, 1) || gain.guided == 0)
+    return false;
+  predicted_gain_ = std::max(float(gain.ratio()), std::numeric_limits<float>::min());
+  return double(predicted_gain_) < settings.min_gain;
+}
+
+void SpatialTree::step_aside() {
+  nodes_.assign(1, Node{});
+  nodes_[0].leaf = 0;
+  leaves_.assign(1, Leaf{});
+  index_nodes();
+  gain_scale_ = 1.f;
+  stepped_aside_ = true;
+  aside_from_ = iteration_;
+}
+
+void SpatialTree::update_gain_scale() {
+  double sum = 0.0;
+  for (const Leaf& l : leaves_) sum += double(l.pixel);
+  const float mean = float(sum / double(leaves_.size()));
+  gain_scale_ = mean > 0.f && std::isfinite(mean) ? mean : 1.f;
 }
 
 bool SpatialTree::operator==(const SpatialTree& other) const {
-  return nodes_ == other.nodes_ && leaves_ == other.leaves_;
+  return nodes_ == other.nodes_ && leaves_ == other.leaves_ && gain_ == other.gain_ &&
+         gain_scale_ == other.gain_scale_ && predicted_gain_ == other.predicted_gain_ &&
+         iteration_ == other.iteration_ && aside_from_ == other.aside_from_ && stepped_aside_ == other.stepped_aside_;
 }
 
 }  // namespace tessera

@@ -14,8 +14,10 @@ namespace {
 
 constexpr char kTreeMagic[4] = {'T', 'S', 'D', 'T'};
 constexpr char kRecordsMagic[4] = {'T', 'S', 'D', 'R'};
-// Version 2 added each leaf's pixel statistics and estimates; version 1 is still read (as zeros).
-constexpr uint32_t kVersion = 2;
+// Version 2 added each leaf's pixel statistics and estimates, version 3 the guide's gain (trees:
+// its sums, prediction and whether it stepped aside; records: their sums). Older versions are
+// still read, as zeros.
+constexpr uint32_t kVersion = 3;
 
 struct Writer {
   std::string& out;
@@ -66,7 +68,7 @@ struct Reader {
     if (in.size() < 8 || std::memcmp(in.data(), m, 4) != 0) return false;
     pos = 4;
     version = get<uint32_t>();
-    return version == 1 || version == kVersion;
+    return version >= 1 && version <= kVersion;
   }
   size_t left() const { return in.size() - pos; }
 };
@@ -128,6 +130,13 @@ struct TreeIo {
       write(w, l.sampling);
       write(w, l.building);
     }
+    w.put(t.gain_.plain);
+    w.put(t.gain_.guided);
+    w.put(t.gain_.paths);
+    w.put(t.predicted_gain_);
+    w.put(t.iteration_);
+    w.put(t.aside_from_);
+    w.put(uint8_t(t.stepped_aside_));
     return out;
   }
 
@@ -175,11 +184,24 @@ struct TreeIo {
            std::isfinite(l.radiance) && std::isfinite(l.pixel) && read(r, l.sampling) && read(r, l.building);
     }
     for (const SpatialTree::Node& n : out.nodes_) ok = ok && (n.leaf == SpatialTree::kNoLeaf || n.leaf < leaves);
+    if (ok && r.version > 2) {
+      out.gain_.plain = r.get<uint64_t>();
+      out.gain_.guided = r.get<uint64_t>();
+      out.gain_.paths = r.get<uint64_t>();
+      out.predicted_gain_ = r.get<float>();
+      out.iteration_ = r.get<uint32_t>();
+      out.aside_from_ = r.get<uint32_t>();
+      const uint8_t aside = r.get<uint8_t>();
+      ok = aside <= 1 && out.predicted_gain_ >= 0.f && std::isfinite(out.predicted_gain_) &&
+           (aside == 1) == (out.aside_from_ > 0) && out.aside_from_ <= out.iteration_;
+      out.stepped_aside_ = aside == 1;
+    }
     if (!ok || !r.ok || r.left() != 0) {
       error = "guide: not a well-formed SD-tree";
       return false;
     }
     out.index_nodes();
+    out.update_gain_scale();
     t = std::move(out);
     return true;
   }
@@ -234,6 +256,9 @@ struct TreeIo {
       w.varint(t.leaves_[pixels[k]].pixel_paths);
       w.varint(t.leaves_[pixels[k]].pixel_sum);
     }
+    w.varint(t.gain_.plain);
+    w.varint(t.gain_.guided);
+    w.varint(t.gain_.paths);
     std::vector<std::pair<uint64_t, uint64_t>> sums;
     for (uint32_t i = 0; i < t.leaves_.size(); ++i) {
       const std::vector<DirectionalTree::Node>& nodes = t.leaves_[i].building.nodes_;
@@ -257,6 +282,7 @@ struct TreeIo {
       uint64_t paths, sum;
     };
     std::vector<Pixel> pixels;
+    GuideGain gain;
     struct Sum {
       uint32_t leaf;
       uint64_t cell;  // node * 4 + quadrant in the leaf's building tree
@@ -295,6 +321,11 @@ bool TreeIo::parse_records(const SpatialTree& t, std::string_view bytes, Records
       const uint64_t paths = r.varint();
       out.pixels.push_back({uint32_t(leaf), paths, r.varint()});
     });
+  if (ok && r.version > 2) {
+    out.gain.plain = r.varint();
+    out.gain.guided = r.varint();
+    out.gain.paths = r.varint();
+  }
   read_list(offset.back(), [&](uint64_t at) {
     // Only leaf quadrants hold recorded sums (inner ones are made by build()).
     const size_t leaf = size_t(std::upper_bound(offset.begin(), offset.end(), at) - offset.begin()) - 1;
@@ -318,6 +349,7 @@ bool TreeIo::add_records(SpatialTree& t, std::string_view bytes, std::string& er
     t.leaves_[p.leaf].pixel_paths += p.paths;
     t.leaves_[p.leaf].pixel_sum += p.sum;
   }
+  t.gain_.merge(records.gain);
   for (const Records::Sum& s : records.sums)  // (wraps as record()'s atomic add does)
     t.leaves_[s.leaf].building.nodes_[s.cell / 4].sum[s.cell % 4] += s.value;
   return true;

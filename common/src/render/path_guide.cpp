@@ -11,10 +11,14 @@ namespace tessera {
 
 void GuideRecords::commit(const PathGuide& guide, const Rgb& radiance, Sampler& sampler) const {
   SpatialTree& tree = *guide.records;
-  if (count_ == 0) return;
+  if (count_ == 0 && !guide.sample) return;
   // Dithers and jitter need no stratification, and a sampler value costs its scrambling hashes:
   // one value seeds a stream for all of them.
   Pcg32 rng(std::bit_cast<uint32_t>(sampler.sample_1d_at(kRecordDimension)));
+  if (count_ == 0) {
+    record_gain(guide, radiance, rng.next_float());
+    return;
+  }
   tree.record_pixel(vertices_.at[0].leaf, radiance.luminance(), rng.next_float());
   // The leaves first, each asked into the cache while the next is found: a record descends a
   // directional tree no recent path has used.
@@ -38,6 +42,14 @@ void GuideRecords::commit(const PathGuide& guide, const Rgb& radiance, Sampler& 
     tree.record_at(leaf, v.square, value, rng.next_float(), guide.directional_filter);
     if (v.mixture) tree.record_fraction(leaf, value * v.f_cos, v.mixture->bsdf, v.mixture->guide);
   }
+  if (guide.sample) record_gain(guide, radiance, rng.next_float());
+}
+
+void GuideRecords::record_gain(const PathGuide& guide, const Rgb& radiance, float dither) const {
+  const float estimate = radiance.luminance();
+  const double scale = double(guide.tree->gain_scale());
+  const double unit = 1.0 / (scale * scale);
+  guide.records->record_gain(gain_.plain_moment(estimate) * unit, PathGain::guided_moment(estimate) * unit, dither);
 }
 
 }  // namespace tessera

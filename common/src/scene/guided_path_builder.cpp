@@ -103,6 +103,13 @@ void read_guided_path(BuildState& st, const SceneNode& node) {
   g.bsdf_fraction = float(number_in(node, name_in(node, "bsdf_sampling_fraction", "bsdfSamplingFraction"), 0.5, 0, 1, true));
   g.spatial_threshold = number_in(node, name_in(node, "s_tree_threshold", "sTreeThreshold"), 12000, 0, 1e9, true);
   g.directional_threshold = number_in(node, name_in(node, "d_tree_threshold", "dTreeThreshold"), 0.01, 0, 1, true);
+  // (Tessera's own: guiding steps aside where the deciding iteration predicts less; 0 never.)
+  g.min_gain = number_in(node, "min_gain", g.min_gain, 0, 1e6, false);
+  const int64_t paths = node.get_int("gain_paths", int64_t(g.gain_paths));
+  if (paths < 1)
+    throw SceneError(node.loc_of("gain_paths"), "'gain_paths' of " + node.describe() + " must be at least 1, got " +
+                                                    std::to_string(paths));
+  g.gain_paths = uint64_t(paths);
   const std::string memory = name_in(node, "sd_tree_max_memory", "sdTreeMaxMemory");
   const int64_t mb = node.get_int(memory, -1);
   if (mb != -1 && (mb < 1 || mb > (int64_t(1) << 20)))

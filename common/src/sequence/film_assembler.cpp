@@ -138,6 +138,12 @@ NoiseEstimate FilmAssembler::noise() const {
   return total > 0 ? NoiseEstimate{1.0 / total, pixels} : NoiseEstimate{kInf, 0};
 }
 
+void FilmAssembler::set_alike_from(uint32_t artifact) {
+  for (const PassSpec& p : program_.passes)
+    if (p.film != kNoFilm && p.uses && *p.uses >= artifact && (alike_from_ < 0 || p.film < alike_from_))
+      alike_from_ = p.film;
+}
+
 std::vector<double> FilmAssembler::weights() const {
   std::vector<double> w(films_.size(), 0.0);
   if (program_.combine == FilmCombine::Sum) {
@@ -150,8 +156,23 @@ std::vector<double> FilmAssembler::weights() const {
     w[f] = std::isfinite(e) ? 1.0 / (e + 1e-12) : 0.0;
     total += w[f];
   }
+  if (alike_from_ >= 0) share_alike(w);
   for (double& x : w) x = total > 0 ? x / total : 1.0 / double(w.size());
   return w;
+}
+
+void FilmAssembler::share_alike(std::vector<double>& w) const {
+  std::vector<double> samples(w.size(), 0.0);
+  for (const PassSpec& p : program_.passes)
+    if (p.kind == UnitKind::Tile && p.film >= alike_from_ && size_t(p.film) < w.size())
+      samples[size_t(p.film)] += p.samples;
+  // (Among the films begun: one without samples yet keeps its weight of 0.)
+  double group = 0, group_samples = 0;
+  for (size_t f = size_t(alike_from_); f < w.size(); ++f)
+    if (w[f] > 0) group += w[f], group_samples += samples[f];
+  if (!(group_samples > 0)) return;
+  for (size_t f = size_t(alike_from_); f < w.size(); ++f)
+    if (w[f] > 0) w[f] = group * samples[f] / group_samples;
 }
 
 Film FilmAssembler::take_film(int f) {

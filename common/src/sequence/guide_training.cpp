@@ -67,6 +67,8 @@ void GuideTraining::restore(uint32_t iteration, std::shared_ptr<const Artifact> 
 void GuideTraining::release() {
   released_bytes_ = tree_bytes();
   released_leaves_ = tree_leaves();
+  released_gain_ = predicted_gain();
+  released_aside_ = stepped_aside();
   tree_.reset();
   training_.reset();
 }

@@ -172,6 +172,7 @@ void PassSequencer::build_artifact(uint32_t iteration) {
   if (artifacts_.size() <= iteration) artifacts_.resize(iteration + 1);
   for (auto& older : artifacts_) older.reset();  // (the passes that used them are complete)
   artifacts_[iteration] = std::move(made);
+  if (const auto from = artifacts_[iteration]->stepped_aside_from()) films_.set_alike_from(*from);
   build_seconds_.resize(artifacts_.size());
   build_seconds_[iteration] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -248,6 +249,7 @@ void PassSequencer::restore_artifacts(std::vector<std::string> hashes, std::shar
   const uint32_t last = uint32_t(hashes.size() - 1);
   builder_->restore(last, latest);
   artifacts_.assign(hashes.size(), nullptr);
+  if (const auto from = latest->stepped_aside_from()) films_.set_alike_from(*from);
   artifacts_[last] = std::move(latest);
   build_seconds_.assign(hashes.size(), 0.0);
   handed_out_ = hashes.size();

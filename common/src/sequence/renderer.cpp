@@ -119,6 +119,8 @@ Film render(const Scene& scene, const RenderSettings& settings, const ProgressCa
     if (training && training->latest()) {
       stats->guide_leaves = training->tree_leaves();
       stats->guide_bytes = training->tree_bytes();
+      stats->guide_gain = training->predicted_gain();
+      stats->guide_stepped_aside = training->stepped_aside();
     }
     stats->noise_estimate = settings.target_error > 0 ? estimate_noise(film).rel_mse : 0;
   }

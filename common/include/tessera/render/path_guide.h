@@ -13,6 +13,7 @@
 
 #include "tessera/core/rgb.h"
 #include "tessera/core/vec.h"
+#include "tessera/guiding/guide_gain.h"
 #include "tessera/guiding/spatial_tree.h"
 #include "tessera/render/guided_sampling.h"
 
@@ -35,10 +36,13 @@ struct PathGuide {
   SpatialFilter spatial_filter = SpatialFilter::Nearest;
   DirectionalFilter directional_filter = DirectionalFilter::Nearest;
 
-  /// A pass's guide as `settings` ask (the one way the renderer and the farm's worker make it).
-  static PathGuide of(const SpatialTree* tree, SpatialTree* records, bool sample, bool train,
-                      const GuidingSettings& settings) {
-    return {tree, records, sample, train, settings.roulette, settings.spatial_filter, settings.directional_filter};
+  /// A pass's guide as `settings` ask (the one way the renderer and the farm's worker make it):
+  /// none once guiding stepped aside (SpatialTree::stepped_aside), when the pass renders as the
+  /// unguided path tracer.
+  static std::optional<PathGuide> of(const SpatialTree* tree, SpatialTree* records, bool sample, bool train,
+                                     const GuidingSettings& settings) {
+    if (tree->stepped_aside()) return std::nullopt;
+    return PathGuide{tree, records, sample, train, settings.roulette, settings.spatial_filter, settings.directional_filter};
   }
 };
 
@@ -57,16 +61,19 @@ class GuideRecords {
   /// vertex (none when the guide did not sample).
   void add(Vec3 p, Vec3 extent, uint32_t leaf, Vec3 wi, float pdf, float f_cos, std::optional<MixturePdfs> mixture,
            const Rgb& throughput, const Rgb& radiance) {
+    if (mixture && mixture->bsdf > 0.f && pdf > 0.f) gain_.scattered(radiance.luminance(), pdf, mixture->bsdf);
     if (count_ >= kCapacity) return;
     // (A guided vertex knows where wi lies on the guide's square; otherwise it is mapped here.)
     const Vec2 square = mixture ? mixture->square : direction_to_square(wi);
     vertices_.at[size_t(count_++)] = {p, extent, leaf, square, pdf, f_cos, mixture, throughput, radiance};
   }
   /// Records every vertex into `guide.records` (through its filters) once the path's estimate is
-  /// `radiance`, and that estimate as a pixel sample at the first vertex's leaf.
+  /// `radiance`, and that estimate as a pixel sample at the first vertex's leaf; in a pass that
+  /// guides, also the path's second moments (guide_gain.h), a path without vertices too.
   void commit(const PathGuide& guide, const Rgb& radiance, Sampler& sampler) const;
 
  private:
+  void record_gain(const PathGuide& guide, const Rgb& radiance, float dither) const;
   struct Vertex {
     Vec3 p, extent;
     uint32_t leaf;
@@ -82,6 +89,7 @@ class GuideRecords {
     Vertex at[kCapacity];
   } vertices_;
   int count_ = 0;
+  PathGain gain_;
 };
 
 }  // namespace tessera

@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -23,6 +24,10 @@ class Artifact {
   virtual std::string encode() const = 0;
   /// What holding it costs a worker in memory.
   virtual size_t memory_bytes() const = 0;
+  /// When the technique stepped aside (the passes that use this artifact render without it, as
+  /// do those of every later one), the first artifact it did so at: from there on the films hold
+  /// samples of one estimator (FilmAssembler::set_alike_from).
+  virtual std::optional<uint32_t> stepped_aside_from() const { return std::nullopt; }
 };
 
 /// Makes a technique's artifacts, iteration after iteration. Records are a unit's contribution to

@@ -72,6 +72,11 @@ class FilmAssembler {
   /// is the largest power of two within its samples; the AOVs are the primary film's.
   Film combined_film() const;
   int primary_film() const { return primary_; }
+  /// (InverseVariance) The films of the passes that use artifact `artifact` or a later one hold
+  /// samples of one estimator (the technique stepped aside: Artifact::stepped_aside_from). They
+  /// are weighed as one film: the sum of their weights, shared in proportion to their samples per
+  /// pixel, rather than by each one's noisier estimate of its own variance.
+  void set_alike_from(uint32_t artifact);
 
   /// The estimate of the image's relMSE (Sum: film 0's; InverseVariance: 1 / the sum of the films'
   /// weights); +inf before there is one.
@@ -101,6 +106,8 @@ class FilmAssembler {
   uint32_t next_tile_pass(uint32_t after) const;
   uint64_t unit_paths(uint32_t pass, uint32_t index) const;
   std::vector<double> weights() const;
+  // The alike films' weights: their sum, in proportion to their passes' samples per pixel.
+  void share_alike(std::vector<double>& w) const;
   void pixel_row(int f, int y, std::vector<float>& row) const;
   void combined_row(int y, const std::vector<double>& w, std::vector<float>& out) const;
 
@@ -110,6 +117,7 @@ class FilmAssembler {
   int full_width_, full_height_;
   bool aovs_;
   int primary_ = 0;
+  int alike_from_ = -1;  // the first film of set_alike_from()'s, or none
   std::vector<std::unique_ptr<Film>> films_;
   std::vector<std::vector<double>> splats_;  // per film: 3 per pixel once a splat arrived
   std::vector<uint64_t> splat_paths_;        // per film: light paths folded into it

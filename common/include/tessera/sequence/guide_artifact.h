@@ -22,6 +22,9 @@ class GuideArtifact final : public Artifact {
   explicit GuideArtifact(std::shared_ptr<const SpatialTree> tree) : tree_(std::move(tree)) {}
   std::string encode() const override { return encode_guide(*tree_); }
   size_t memory_bytes() const override { return tree_->bytes(); }
+  std::optional<uint32_t> stepped_aside_from() const override {
+    return tree_->stepped_aside() ? std::optional(tree_->aside_from()) : std::nullopt;
+  }
   const SpatialTree& tree() const { return *tree_; }
   const std::shared_ptr<const SpatialTree>& shared_tree() const { return tree_; }
 

@@ -43,6 +43,10 @@ class GuideTraining final : public ArtifactBuilder {
   /// The latest tree's size; kept once released (a finished job's status).
   size_t tree_bytes() const { return tree_ ? tree_->bytes() : released_bytes_; }
   size_t tree_leaves() const { return tree_ ? tree_->leaf_count() : released_leaves_; }
+  /// The gain the deciding iteration predicted (0 before it) and whether guiding stepped aside
+  /// (SpatialTree); kept once released.
+  float predicted_gain() const { return tree_ ? tree_->predicted_gain() : released_gain_; }
+  bool stepped_aside() const { return tree_ ? tree_->stepped_aside() : released_aside_; }
 
  private:
   Bounds3 bounds_;
@@ -53,6 +57,8 @@ class GuideTraining final : public ArtifactBuilder {
   std::unique_ptr<SpatialTree> training_;      // that tree plus the records added so far
   double build_seconds_ = 0;
   size_t released_bytes_ = 0, released_leaves_ = 0;
+  float released_gain_ = 0.f;
+  bool released_aside_ = false;
 };
 
 }  // namespace tessera

@@ -53,6 +53,8 @@ struct RenderStats {
   uint32_t spp_done = 0;      // samples per pixel rendered (less than spp when a target stopped it)
   double noise_estimate = 0;  // estimated relMSE of the result (only computed with a target)
   size_t guide_leaves = 0, guide_bytes = 0;  // the learned SD-tree, when guided
+  float guide_gain = 0.f;                     // its predicted gain (guide_gain.h; 0: not decided)
+  bool guide_stepped_aside = false;           // guiding stepped aside: the rest rendered unguided
 };
 
 struct RenderProgress {

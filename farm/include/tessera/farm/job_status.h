@@ -43,6 +43,8 @@ struct JobStatus {
   struct Guide {
     uint32_t iterations = 0;
     uint64_t leaves = 0, bytes = 0;
+    float predicted_gain = 0.f;  // 0 before the deciding iteration (guide_gain.h)
+    bool stepped_aside = false;
   };
   std::optional<Guide> guide;
   /// An sppm or vcm job's point maps: maps stored so far (one per pass), and the latest one's
