@@ -247,7 +247,10 @@ json guide_json(const JobPlan::Guide& g) {
           {"combined_iterations", s.combined_iterations},
           {"roulette", guide_roulette_name(s.roulette)},
           {"spatial_filter", spatial_filter_name(s.spatial_filter)},
-          {"directional_filter", directional_filter_name(s.directional_filter)}};
+          {"directional_filter", directional_filter_name(s.directional_filter)},
+          {"min_gain", s.min_gain},
+          {"gain_iteration_spp", s.gain_iteration_spp},
+          {"gain_paths", s.gain_paths}};
 }
 
 JobPlan::Guide guide_from_json(const json& j) {
@@ -276,6 +279,11 @@ JobPlan::Guide guide_from_json(const json& j) {
   if (!parse_directional_filter(j.value("directional_filter", "nearest"), s.directional_filter))
     throw std::invalid_argument("guide directional_filter");
   if (s.combined_iterations < 1) throw std::invalid_argument("guide combined_iterations");
+  // (A plan stored before guiding could step aside never did.)
+  s.min_gain = j.value("min_gain", 0.0);
+  s.gain_iteration_spp = j.value("gain_iteration_spp", s.gain_iteration_spp);
+  s.gain_paths = j.value("gain_paths", s.gain_paths);
+  if (!(s.min_gain >= 0.0) || s.gain_paths < 1) throw std::invalid_argument("guide min_gain or gain_paths");
   return g;
 }
 

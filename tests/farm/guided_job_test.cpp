@@ -51,13 +51,25 @@ std::string guided_xml(const std::string& combination) {
   return xml.replace(xml.find(discard), discard.size(), "value=\"" + combination + "\"");
 }
 
-LoadResult load_fixture_scene(const std::string& combination = "discard") {
-  return load_scene(parse_scene_string(guided_xml(combination), "scene.xml"), LoadOptions{});
+// The fixture at 80 spp (iterations of 1, 2, 4, 8, 16 and 49 samples) with a least gain no guide
+// reaches, decided by 100 paths: guiding steps aside after the iteration of 8, the iteration of 16
+// trains nothing, and both render unguided.
+constexpr int kAsideSpp = 80;
+std::string stepping_aside_xml(const std::string& combination = "inversevar") {
+  std::string xml = guided_xml(combination);
+  const std::string budget = "<float name=\"budget\" value=\"24\"/>";
+  return xml.replace(xml.find(budget), budget.size(),
+                     "<float name=\"budget\" value=\"80\"/><float name=\"min_gain\" value=\"1000\"/>"
+                     "<integer name=\"gain_paths\" value=\"100\"/>");
 }
 
-std::string guided_bundle(const std::string& combination = "discard") {
+LoadResult load_fixture_scene(const std::string& xml = guided_xml("discard")) {
+  return load_scene(parse_scene_string(xml, "scene.xml"), LoadOptions{});
+}
+
+std::string guided_bundle(const std::string& xml) {
   TempDir src;
-  src.write("scene.xml", guided_xml(combination));
+  src.write("scene.xml", xml);
   return pack_bundle(src.path.string(), {"scene.xml"});
 }
 
@@ -144,24 +156,16 @@ TEST(GuidedJob, UnitsInAnyOrderStitchToTheLocalGuidedRender) {
   EXPECT_EQ(local.pixel({3, 3}).count, uint64_t(kSpp - 7)) << "the training passes are not in the image";
 }
 
-// 80 spp: iterations of 1, 2, 4, 8, 16 and 49 samples. With a least gain no guide reaches, guiding
-// steps aside after the iteration of 8: the iteration of 16 trains nothing, and both render
-// unguided.
 TEST(GuidedJob, AGuideThatStepsAsideStitchesToTheLocalRender) {
-  std::string xml = kGuidedXml;
-  const std::string budget = "<float name=\"budget\" value=\"24\"/>";
-  xml.replace(xml.find(budget), budget.size(),
-              "<float name=\"budget\" value=\"80\"/><float name=\"min_gain\" value=\"1000\"/>"
-              "<integer name=\"gain_paths\" value=\"100\"/>");
-  LoadResult loaded = load_scene(parse_scene_string(xml, "scene.xml"), LoadOptions{});
+  LoadResult loaded = load_fixture_scene(stepping_aside_xml("discard"));
   const Scene& scene = *loaded.scene;
-  const ShuffledJob shuffled = render_shuffled(scene, 80);
+  const ShuffledJob shuffled = render_shuffled(scene, kAsideSpp);
   const JobState& job = *shuffled.job;
   ASSERT_TRUE(job.complete());
   ASSERT_TRUE(job.guide());
   EXPECT_TRUE(job.guide()->stepped_aside());
   EXPECT_GT(job.guide()->predicted_gain(), 0.f);
-  EXPECT_EQ(differing(job.film(), local_guided_render(scene, 4, false, 80)), 0);
+  EXPECT_EQ(differing(job.film(), local_guided_render(scene, 4, false, kAsideSpp)), 0);
 }
 
 // Renders a lease as a worker does, fetching its guide from the coordinator.
@@ -186,28 +190,37 @@ std::string render_guided_unit(Coordinator& c, const json& lease_json, const Sce
 // A coordinator stopped and started again every few results, in the middle of training (its
 // tree rebuilt from the stored guide and the training records of the pass in progress), with
 // adaptive sampling too.
-void expect_restarts_give_the_local_image(const std::string& combination) {
+void expect_restarts_give_the_local_image(const std::string& xml, int spp = kSpp) {
   TempDir dir;
-  LoadResult loaded = load_fixture_scene(combination);
-  const json settings = {{"tile_size", 8}, {"seed", 7}, {"spp", kSpp}, {"adaptive", true}};  // (guided: the scene says)
+  LoadResult loaded = load_fixture_scene(xml);
+  const json settings = {{"tile_size", 8}, {"seed", 7}, {"spp", spp}, {"adaptive", true}};  // (guided: the scene says)
   int restarts = 0;
-  const uint64_t id = render_with_restarts(dir, settings, guided_bundle(combination), [&](Coordinator& c, const json& l) {
+  const uint64_t id = render_with_restarts(dir, settings, guided_bundle(xml), [&](Coordinator& c, const json& l) {
     return render_guided_unit(c, l, *loaded.scene, 7);
   }, restarts);
   EXPECT_GT(restarts, 5);
   Coordinator c(options(dir));
-  EXPECT_EQ(c.job_status(id).value.spp, kSpp);
+  EXPECT_EQ(c.job_status(id).value.spp, spp);
   const Image farm = pfm_image(c.job_image(id, "pfm").value.bytes);
-  const Image local = local_guided_render(*loaded.scene, 7, /*adaptive=*/true).to_image();
+  const Image local = local_guided_render(*loaded.scene, 7, /*adaptive=*/true, spp).to_image();
   ASSERT_EQ(farm.values().size(), local.values().size());
   EXPECT_TRUE(std::memcmp(farm.values().data(), local.values().data(), local.values().size() * sizeof(float)) == 0);
 }
 
-TEST(GuidedJob, RestartsDuringTrainingGiveTheLocalGuidedImage) { expect_restarts_give_the_local_image("discard"); }
+TEST(GuidedJob, RestartsDuringTrainingGiveTheLocalGuidedImage) { expect_restarts_give_the_local_image(guided_xml("discard")); }
 
 // The same with the image made of the last iterations' films, combined by inverse variance: each
 // tile's checkpoint holds its sums in every film.
-TEST(GuidedJob, RestartsGiveTheLocalImageOfCombinedIterations) { expect_restarts_give_the_local_image("inversevar"); }
+TEST(GuidedJob, RestartsGiveTheLocalImageOfCombinedIterations) {
+  expect_restarts_give_the_local_image(guided_xml("inversevar"));
+}
+
+// And a job whose guide steps aside (as AGuideThatStepsAsideStitchesToTheLocalRender shows): the
+// coordinator keeps the scene's least gain through restarts, and a restarted one reads from its
+// latest tree where the films of one estimator begin.
+TEST(GuidedJob, RestartsGiveTheLocalImageOfAGuideThatSteppedAside) {
+  expect_restarts_give_the_local_image(stepping_aside_xml(), kAsideSpp);
+}
 
 }  // namespace
 }  // namespace tessera::test
