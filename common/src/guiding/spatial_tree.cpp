@@ -163,7 +163,7 @@ double spatial_split_threshold(const GuidingSettings& settings, uint32_t iterati
 
 void SpatialTree::end_iteration(uint32_t iteration_spp, const GuidingSettings& settings) {
   ++iteration_;
-  if (stepped_aside_) return;
+  if (stepped_aside()) return;
   if (decide_gain(iteration_spp, settings)) {
     step_aside();
     return;
@@ -221,7 +221,6 @@ void SpatialTree::step_aside() {
   leaves_.assign(1, Leaf{});
   index_nodes();
   gain_scale_ = 1.f;
-  stepped_aside_ = true;
   aside_from_ = iteration_;
 }
 
@@ -235,7 +234,7 @@ void SpatialTree::update_gain_scale() {
 bool SpatialTree::operator==(const SpatialTree& other) const {
   return nodes_ == other.nodes_ && leaves_ == other.leaves_ && gain_ == other.gain_ &&
          gain_scale_ == other.gain_scale_ && predicted_gain_ == other.predicted_gain_ &&
-         iteration_ == other.iteration_ && aside_from_ == other.aside_from_ && stepped_aside_ == other.stepped_aside_;
+         iteration_ == other.iteration_ && aside_from_ == other.aside_from_;
 }
 
 }  // namespace tessera

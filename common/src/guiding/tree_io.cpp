@@ -15,7 +15,7 @@ namespace {
 constexpr char kTreeMagic[4] = {'T', 'S', 'D', 'T'};
 constexpr char kRecordsMagic[4] = {'T', 'S', 'D', 'R'};
 // Version 2 added each leaf's pixel statistics and estimates, version 3 the guide's gain (trees:
-// its sums, prediction and whether it stepped aside; records: their sums). Older versions are
+// its sums, prediction, iteration and the one it stepped aside at; records: their sums). Older versions are
 // still read, as zeros.
 constexpr uint32_t kVersion = 3;
 
@@ -136,7 +136,6 @@ struct TreeIo {
     w.put(t.predicted_gain_);
     w.put(t.iteration_);
     w.put(t.aside_from_);
-    w.put(uint8_t(t.stepped_aside_));
     return out;
   }
 
@@ -191,10 +190,7 @@ struct TreeIo {
       out.predicted_gain_ = r.get<float>();
       out.iteration_ = r.get<uint32_t>();
       out.aside_from_ = r.get<uint32_t>();
-      const uint8_t aside = r.get<uint8_t>();
-      ok = aside <= 1 && out.predicted_gain_ >= 0.f && std::isfinite(out.predicted_gain_) &&
-           (aside == 1) == (out.aside_from_ > 0) && out.aside_from_ <= out.iteration_;
-      out.stepped_aside_ = aside == 1;
+      ok = out.predicted_gain_ >= 0.f && std::isfinite(out.predicted_gain_) && out.aside_from_ <= out.iteration_;
     }
     if (!ok || !r.ok || r.left() != 0) {
       error = "guide: not a well-formed SD-tree";

@@ -174,7 +174,7 @@ class SpatialTree {
   void end_iteration(uint32_t iteration_spp, const GuidingSettings& settings);
   /// Guiding stepped aside: the tree is a single empty leaf, and the passes that use it render as
   /// the unguided path tracer (PathGuide::of).
-  bool stepped_aside() const { return stepped_aside_; }
+  bool stepped_aside() const { return aside_from_ > 0; }
   /// The gain the deciding iteration predicted (0 before it).
   float predicted_gain() const { return predicted_gain_; }
   /// The tree's iteration: 0 as made, one more at every end_iteration().
@@ -227,8 +227,7 @@ class SpatialTree {
   GuideGain gain_;  // the iteration's, as records are
   float gain_scale_ = 1.f;
   float predicted_gain_ = 0.f;
-  uint32_t iteration_ = 0, aside_from_ = 0;
-  bool stepped_aside_ = false;
+  uint32_t iteration_ = 0, aside_from_ = 0;  // (aside_from_ 0: guiding has not stepped aside)
 };
 
 }  // namespace tessera
